@@ -1,0 +1,159 @@
+//! `inspect`: per-tooth mesh data and exact gaps and penetrations of a case's teeth.
+//!
+//! Every figure is computed from the meshes: `closed` is [`TriMesh::validate_solid`]'s verdict,
+//! gaps and penetrations come from the exact mesh–mesh query
+//! ([`crate::geometry::mesh_separation`]).
+
+use serde::Serialize;
+
+use crate::{
+    geometry::{mesh_separation, TriMesh},
+    teeth::{arch::OcclusionMeasures, Dentition, PlacedTooth},
+};
+
+/// One tooth's line of the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct ToothReport {
+    /// FDI number.
+    pub fdi: u8,
+    /// Kind (snake_case).
+    pub kind: &'static str,
+    /// "upper" or "lower".
+    pub arch: &'static str,
+    /// Mesh vertices.
+    pub vertices: usize,
+    /// Mesh triangles.
+    pub triangles: usize,
+    /// True when the mesh is closed, manifold, outward, finite and free of self-intersection.
+    pub closed: bool,
+    /// Why it is not, when it is not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_error: Option<String>,
+    /// Enclosed volume (mm³).
+    pub volume_mm3: f64,
+    /// Crown centre, world frame (mm).
+    pub crown_centre: [f32; 3],
+    /// Extracted tooth.
+    pub extracted: bool,
+}
+
+/// The exact gap between two adjacent teeth.
+#[derive(Clone, Debug, Serialize)]
+pub struct NeighbourGap {
+    /// First tooth.
+    pub a: u8,
+    /// Second tooth.
+    pub b: u8,
+    /// Minimal surface distance (mm), negative when they overlap (minus the penetration depth).
+    pub gap_mm: f32,
+}
+
+/// The whole report of `orthosim inspect`.
+#[derive(Clone, Debug, Serialize)]
+pub struct InspectReport {
+    /// Case name.
+    pub case: String,
+    /// Where the case came from.
+    pub origin: String,
+    /// Target vertices per tooth.
+    pub resolution: u32,
+    /// Teeth in FDI order.
+    pub teeth: Vec<ToothReport>,
+    /// Adjacent visible teeth along each arch (extracted ones skipped).
+    pub neighbour_gaps_mm: Vec<NeighbourGap>,
+    /// Deepest penetration between any two visible teeth of the same arch (mm, 0 when none).
+    pub max_penetration_mm: f32,
+    /// Deepest penetration between an upper and a lower visible tooth (mm, 0 when none).
+    pub occlusal_max_penetration_mm: f32,
+    /// Least gap between the arches (mm; negative when they overlap).
+    pub occlusal_min_gap_mm: f32,
+    /// Overjet, overbite and molar relation of the underlying arrangement.
+    pub occlusion: OcclusionMeasures,
+}
+
+fn signed_gap(a: &PlacedTooth, b: &PlacedTooth) -> f32 {
+    mesh_separation(a.geometry.mesh_ref(), &a.pose, b.geometry.mesh_ref(), &b.pose).signed_gap()
+}
+
+/// Reports on mesh `m`'s validity.
+fn validity(m: &TriMesh) -> Result<(), String> {
+    m.validate_solid().map(|_| ()).map_err(|e| e.to_string())
+}
+
+/// Computes the report of a dentition.
+pub fn inspect(d: &Dentition) -> InspectReport {
+    let teeth = d
+        .teeth
+        .iter()
+        .map(|t| {
+            let m = &t.geometry.mesh;
+            let valid = validity(m);
+            ToothReport {
+                fdi: t.fdi.number(),
+                kind: t.fdi.kind().name(),
+                arch: match t.fdi.arch() {
+                    crate::teeth::Arch::Upper => "upper",
+                    crate::teeth::Arch::Lower => "lower",
+                },
+                vertices: m.vertices.len(),
+                triangles: m.triangles.len(),
+                closed: valid.is_ok(),
+                mesh_error: valid.err(),
+                volume_mm3: t.geometry.frame.volume_mm3,
+                crown_centre: t.crown_centre().to_array(),
+                extracted: t.extracted,
+            }
+        })
+        .collect();
+    let neighbour_gaps_mm = d
+        .neighbour_pairs()
+        .into_iter()
+        .filter_map(|(a, b)| Some((d.tooth(a)?, d.tooth(b)?)))
+        .map(|(a, b)| NeighbourGap {
+            a: a.fdi.number(),
+            b: b.fdi.number(),
+            gap_mm: signed_gap(a, b),
+        })
+        .collect();
+    let visible: Vec<&PlacedTooth> = d.visible().collect();
+    let (mut same_arch, mut occlusal, mut occlusal_gap) = (0.0f32, 0.0f32, f32::INFINITY);
+    for (i, a) in visible.iter().enumerate() {
+        for b in &visible[i + 1..] {
+            // Teeth whose bounding spheres are apart cannot touch.
+            let (ra, rb) = (bounding_radius(a), bounding_radius(b));
+            let (ca, cb) = (a.pose.translation, b.pose.translation);
+            let same = a.fdi.arch() == b.fdi.arch();
+            if ca.distance(cb) > ra + rb {
+                continue;
+            }
+            let g = signed_gap(a, b);
+            if same {
+                same_arch = same_arch.max(-g);
+            } else {
+                occlusal = occlusal.max(-g);
+                occlusal_gap = occlusal_gap.min(g);
+            }
+        }
+    }
+    InspectReport {
+        case: d.case.case.name.clone(),
+        origin: d.case.origin.clone(),
+        resolution: d.case.case.tooth_resolution().vertices,
+        teeth,
+        neighbour_gaps_mm,
+        max_penetration_mm: same_arch,
+        occlusal_max_penetration_mm: occlusal,
+        occlusal_min_gap_mm: occlusal_gap,
+        occlusion: d.arrangement,
+    }
+}
+
+/// Radius about the local origin that bounds the tooth.
+fn bounding_radius(t: &PlacedTooth) -> f32 {
+    t.geometry
+        .mesh
+        .vertices
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max)
+}

@@ -1,0 +1,5 @@
+//! Analysis: measures computed from placed teeth (no ECS needed).
+
+pub mod inspect;
+
+pub use inspect::{inspect, InspectReport};

@@ -1,0 +1,151 @@
+//! `TriangleBvh`: a binary bounding-box hierarchy over a mesh's triangles, in the mesh's local frame.
+
+use glam::Vec3;
+
+use super::{aabb::Aabb, trimesh::TriMesh};
+
+/// Most triangles kept in one leaf.
+const LEAF_SIZE: usize = 4;
+
+/// One node: its box and either two children or a range of `order`.
+#[derive(Clone, Copy, Debug)]
+pub struct BvhNode {
+    /// Bounds of every triangle below this node.
+    pub aabb: Aabb,
+    /// Leaf: index of the first triangle in [`TriangleBvh::order`]; inner: index of the left child
+    /// (the right child is `left + 1`).
+    pub start: u32,
+    /// Number of triangles for a leaf, 0 for an inner node.
+    pub count: u32,
+}
+
+impl BvhNode {
+    /// True for a leaf.
+    #[inline]
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+/// Bounding-box hierarchy over triangles, built by median splits on the longest axis.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleBvh {
+    /// Nodes; node 0 is the root.
+    pub nodes: Vec<BvhNode>,
+    /// Triangle indices, grouped by leaf.
+    pub order: Vec<u32>,
+}
+
+impl TriangleBvh {
+    /// Builds the hierarchy for `mesh`'s triangles.
+    pub fn build(mesh: &TriMesh) -> Self {
+        let boxes: Vec<Aabb> = (0..mesh.triangles.len())
+            .map(|i| Aabb::from_points(mesh.triangle(i)))
+            .collect();
+        let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
+        let mut bvh = Self {
+            nodes: Vec::with_capacity(2 * mesh.triangles.len() / LEAF_SIZE + 1),
+            order: (0..mesh.triangles.len() as u32).collect(),
+        };
+        if mesh.triangles.is_empty() {
+            return bvh;
+        }
+        bvh.nodes.push(BvhNode {
+            aabb: Aabb::EMPTY,
+            start: 0,
+            count: 0,
+        });
+        let n = bvh.order.len();
+        bvh.split(0, 0, n, &boxes, &centres);
+        bvh
+    }
+
+    fn split(&mut self, node: usize, lo: usize, hi: usize, boxes: &[Aabb], centres: &[Vec3]) {
+        let aabb = self.order[lo..hi]
+            .iter()
+            .fold(Aabb::EMPTY, |b, &t| b.union(boxes[t as usize]));
+        if hi - lo <= LEAF_SIZE {
+            self.nodes[node] = BvhNode {
+                aabb,
+                start: lo as u32,
+                count: (hi - lo) as u32,
+            };
+            return;
+        }
+        let cb = Aabb::from_points(self.order[lo..hi].iter().map(|&t| centres[t as usize]));
+        let e = cb.extent();
+        let axis = if e.x >= e.y && e.x >= e.z {
+            0
+        } else if e.y >= e.z {
+            1
+        } else {
+            2
+        };
+        let mid = (lo + hi) / 2;
+        self.order[lo..hi].select_nth_unstable_by(mid - lo, |&a, &b| {
+            centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
+        });
+        let left = self.nodes.len();
+        let empty = BvhNode {
+            aabb: Aabb::EMPTY,
+            start: 0,
+            count: 0,
+        };
+        self.nodes.push(empty);
+        self.nodes.push(empty);
+        self.nodes[node] = BvhNode {
+            aabb,
+            start: left as u32,
+            count: 0,
+        };
+        self.split(left, lo, mid, boxes, centres);
+        self.split(left + 1, mid, hi, boxes, centres);
+    }
+
+    /// The triangles of a leaf node.
+    #[inline]
+    pub fn leaf_triangles(&self, node: &BvhNode) -> &[u32] {
+        &self.order[node.start as usize..(node.start + node.count) as usize]
+    }
+
+    /// Bounds of the whole mesh.
+    pub fn root_aabb(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| n.aabb)
+    }
+
+    /// Calls `f(i, j)` (i ≠ j, each unordered pair once) for every pair of triangles whose boxes
+    /// overlap; `f` returns false to stop.
+    pub fn self_pairs(&self, f: &mut impl FnMut(usize, usize) -> bool) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = vec![(0u32, 0u32)];
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+            if na.aabb.distance_squared(&nb.aabb) > 0.0 {
+                continue;
+            }
+            match (na.is_leaf(), nb.is_leaf()) {
+                (true, true) => {
+                    let (ta, tb) = (self.leaf_triangles(na), self.leaf_triangles(nb));
+                    for (x, &i) in ta.iter().enumerate() {
+                        let others = if a == b { &tb[x + 1..] } else { tb };
+                        for &j in others {
+                            if !f(i as usize, j as usize) {
+                                return;
+                            }
+                        }
+                    }
+                }
+                _ if a == b => {
+                    let l = na.start;
+                    stack.extend([(l, l), (l + 1, l + 1), (l, l + 1)]);
+                }
+                (false, _) if nb.is_leaf() || na.aabb.extent().length() >= nb.aabb.extent().length() => {
+                    stack.extend([(na.start, b), (na.start + 1, b)]);
+                }
+                _ => stack.extend([(a, nb.start), (a, nb.start + 1)]),
+            }
+        }
+    }
+}

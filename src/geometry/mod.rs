@@ -1,0 +1,25 @@
+//! Engine-free geometry on glam: validated triangle meshes, mass properties, exact triangle queries,
+//! a bounding-volume hierarchy for mesh–mesh distance, and mesh simplification.
+//!
+//! Nothing here touches the ECS; every function is callable from a test, a benchmark or another
+//! engine. Lengths are millimetres.
+
+pub mod aabb;
+pub mod bvh;
+pub mod closest;
+pub mod decimate;
+pub mod mass;
+pub mod mesh_distance;
+pub mod pose;
+pub mod trimesh;
+
+pub use aabb::Aabb;
+pub use bvh::TriangleBvh;
+pub use closest::{
+    closest_point_triangle, closest_points_segment_segment, closest_points_triangle_triangle,
+    triangles_intersect, TrianglePair,
+};
+pub use mass::MassProperties;
+pub use mesh_distance::{mesh_separation, MeshRef, MeshSeparation};
+pub use pose::Pose;
+pub use trimesh::{MeshError, TriMesh};

@@ -1,0 +1,138 @@
+//! The `orthosim` command: the viewer by default, headless subcommands for everything else.
+
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use orthosim::{
+    analysis::inspect,
+    teeth::{Case, Dentition},
+};
+
+/// orthosim: interactive orthodontic simulation with fast, exact tooth collision detection.
+#[derive(Parser, Debug)]
+#[command(version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Open the 3D viewer (the default when no subcommand is given).
+    View {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "normal")]
+        case: String,
+    },
+    /// List the built-in cases, one line each.
+    Cases,
+    /// Print per-tooth mesh data and exact gaps and penetrations of a case.
+    Inspect {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "normal")]
+        case: String,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command.unwrap_or(Command::View {
+        case: "normal".into(),
+    }) {
+        Command::View { case } => view(&case),
+        Command::Cases => {
+            list_cases();
+            Ok(())
+        }
+        Command::Inspect { case, json } => run_inspect(&case, json),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("orthosim: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn list_cases() {
+    for name in Case::builtin_names() {
+        let loaded = Case::resolve(name).expect("built-in cases are valid");
+        println!("{name:<8} {}", loaded.case.description);
+    }
+}
+
+fn run_inspect(case: &str, json: bool) -> Result<()> {
+    let loaded = Case::resolve(case)?;
+    let dentition = Dentition::build(loaded)?;
+    let report = inspect(&dentition);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report).context("writing JSON")?);
+        return Ok(());
+    }
+    println!("case {} ({}), {} vertices per tooth", report.case, report.origin, report.resolution);
+    println!("{:>4} {:<16} {:<6} {:>5} {:>5} {:>7} {:>9}  crown centre (mm)", "fdi", "kind", "arch", "verts", "tris", "closed", "vol mm3");
+    for t in &report.teeth {
+        let c = t.crown_centre;
+        println!(
+            "{:>4} {:<16} {:<6} {:>5} {:>5} {:>7} {:>9.1}  ({:>6.2}, {:>6.2}, {:>6.2}){}",
+            t.fdi,
+            t.kind,
+            t.arch,
+            t.vertices,
+            t.triangles,
+            t.closed,
+            t.volume_mm3,
+            c[0],
+            c[1],
+            c[2],
+            if t.extracted { "  extracted" } else { "" }
+        );
+    }
+    println!("neighbour gaps (mm):");
+    for g in &report.neighbour_gaps_mm {
+        println!("  {}-{}: {:.3}", g.a, g.b, g.gap_mm);
+    }
+    println!("max penetration in an arch: {:.4} mm", report.max_penetration_mm);
+    println!(
+        "max penetration between arches: {:.4} mm (least gap {:.4} mm)",
+        report.occlusal_max_penetration_mm, report.occlusal_min_gap_mm
+    );
+    let o = report.occlusion;
+    println!(
+        "overjet {:.2} mm, overbite {:.2} mm, molar relation {:+.2} mm (0 = class I)",
+        o.overjet_mm, o.overbite_mm, o.molar_relation_mm
+    );
+    Ok(())
+}
+
+#[cfg(feature = "viewer")]
+fn view(case: &str) -> Result<()> {
+    use bevy::prelude::*;
+    use orthosim::{occlusion_view::OcclusionViewPlugin, teeth::TeethModelPlugin, OrthoSimPlugins};
+    // Fail early, with the file position, before a window opens.
+    Case::resolve(case)?;
+    App::new()
+        .add_plugins(DefaultPlugins.set(WindowPlugin {
+            primary_window: Some(Window {
+                title: format!("orthosim: {case}"),
+                ..default()
+            }),
+            ..default()
+        }))
+        .add_plugins(OrthoSimPlugins.set(TeethModelPlugin {
+            initial_case: Some(case.to_owned()),
+        }))
+        .add_plugins(OcclusionViewPlugin)
+        .run();
+    Ok(())
+}
+
+#[cfg(not(feature = "viewer"))]
+fn view(_case: &str) -> Result<()> {
+    anyhow::bail!("this build has no viewer (built without the `viewer` feature); use a headless subcommand, see --help")
+}

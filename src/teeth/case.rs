@@ -1,0 +1,607 @@
+//! Patient cases: the RON schema, the built-in cases, and loading with precise error positions.
+//!
+//! Every problem in a case file is reported as one line `file:line:column: problem`: syntax errors,
+//! unknown fields, unknown or duplicate teeth, non-finite numbers, negative sizes, loads on extracted
+//! or absent teeth, absurd load magnitudes. See the README for the schema.
+
+use std::{collections::BTreeMap, fmt, path::Path};
+
+use serde::{
+    de::{self, MapAccess, SeqAccess, Visitor},
+    Deserialize, Deserializer, Serialize,
+};
+use thiserror::Error;
+
+use super::{fdi::Fdi, shape::ToothResolution};
+
+/// The built-in cases: name and RON source (embedded in the binary).
+pub const BUILTIN_CASES: [(&str, &str); 4] = [
+    ("normal", include_str!("../../assets/cases/normal.ron")),
+    ("case1", include_str!("../../assets/cases/case1.ron")),
+    ("case2", include_str!("../../assets/cases/case2.ron")),
+    ("case3", include_str!("../../assets/cases/case3.ron")),
+];
+
+/// Largest force accepted on one load (N); orthodontic forces are 0.1–5 N.
+pub const MAX_FORCE_N: f32 = 50.0;
+/// Largest torque accepted on one load (N·mm); orthodontic moments are up to about 30 N·mm.
+pub const MAX_TORQUE_NMM: f32 = 500.0;
+
+/// A case file that could not be read or is not valid.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum CaseError {
+    /// The file could not be read.
+    #[error("{path}: cannot read case file: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What the system said.
+        message: String,
+    },
+    /// The file is not a valid case; `line` and `column` are 1-based.
+    #[error("{path}:{line}:{column}: {message}")]
+    Invalid {
+        /// The file (or `builtin:NAME`).
+        path: String,
+        /// Line of the problem.
+        line: usize,
+        /// Column of the problem.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The name is neither a built-in case nor an existing file.
+    #[error("unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file")]
+    Unknown(String),
+}
+
+/// An f32 that must be finite (NaN and infinities are refused where they are read).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct Finite(pub f32);
+
+impl<'de> Deserialize<'de> for Finite {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = f64::deserialize(d)?;
+        if !v.is_finite() || v.abs() > f32::MAX as f64 {
+            return Err(de::Error::custom(format!("number must be finite, got {v}")));
+        }
+        Ok(Self(v as f32))
+    }
+}
+
+/// A finite, non-negative f32 (sizes, limits).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct NonNegative(pub f32);
+
+impl<'de> Deserialize<'de> for NonNegative {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(v) = Finite::deserialize(d)?;
+        if v < 0.0 {
+            return Err(de::Error::custom(format!("size must not be negative, got {v}")));
+        }
+        Ok(Self(v))
+    }
+}
+
+/// A list of distinct teeth (a duplicate is an error at its position).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct ToothList(pub Vec<Fdi>);
+
+impl<'de> Deserialize<'de> for ToothList {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ToothList;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a list of FDI tooth numbers")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<ToothList, A::Error> {
+                let mut out = Vec::new();
+                while let Some(t) = seq.next_element::<Fdi>()? {
+                    if out.contains(&t) {
+                        return Err(de::Error::custom(format!("duplicate tooth {t}")));
+                    }
+                    out.push(t);
+                }
+                Ok(ToothList(out))
+            }
+        }
+        d.deserialize_seq(V)
+    }
+}
+
+/// A map keyed by tooth whose keys must be distinct.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(transparent)]
+pub struct ToothMap<T>(pub BTreeMap<Fdi, T>);
+
+impl<T> Default for ToothMap<T> {
+    fn default() -> Self {
+        Self(BTreeMap::new())
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for ToothMap<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
+            type Value = ToothMap<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a map from FDI tooth numbers")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ToothMap<T>, A::Error> {
+                let mut out = BTreeMap::new();
+                while let Some(k) = map.next_key::<Fdi>()? {
+                    if out.contains_key(&k) {
+                        return Err(de::Error::custom(format!("duplicate tooth {k}")));
+                    }
+                    let v = map.next_value::<T>()?;
+                    out.insert(k, v);
+                }
+                Ok(ToothMap(out))
+            }
+        }
+        d.deserialize_map(V(std::marker::PhantomData))
+    }
+}
+
+/// A vector given in the world frame or in a tooth's anatomical frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CaseVector {
+    /// World frame: +x patient's left, +y up, +z anterior.
+    World(Finite, Finite, Finite),
+    /// Components along the tooth's mesial, buccal and occlusal directions (for a torque: about
+    /// those axes, right-handed). Missing components are zero.
+    Anatomical {
+        /// Towards the midline along the arch.
+        #[serde(default)]
+        mesial: Finite,
+        /// Towards the cheeks / lips.
+        #[serde(default)]
+        buccal: Finite,
+        /// Towards the occlusal plane (extrusion).
+        #[serde(default)]
+        occlusal: Finite,
+    },
+}
+
+impl Default for CaseVector {
+    fn default() -> Self {
+        Self::World(Finite(0.0), Finite(0.0), Finite(0.0))
+    }
+}
+
+impl CaseVector {
+    /// Length of the vector.
+    pub fn magnitude(&self) -> f32 {
+        let (a, b, c) = match *self {
+            Self::World(a, b, c) => (a, b, c),
+            Self::Anatomical {
+                mesial,
+                buccal,
+                occlusal,
+            } => (mesial, buccal, occlusal),
+        };
+        glam::Vec3::new(a.0, b.0, c.0).length()
+    }
+}
+
+/// A force system on a tooth or a group of teeth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseLoad {
+    /// The loaded teeth.
+    pub teeth: ToothList,
+    /// Force (N).
+    #[serde(default)]
+    pub force: CaseVector,
+    /// Torque (N·mm).
+    #[serde(default)]
+    pub torque: CaseVector,
+    /// True: the teeth move as one block (a segment on a wire); false: each tooth gets the load.
+    #[serde(default)]
+    pub as_group: bool,
+}
+
+/// Archwire cross-section, which decides how a tooth responds to a load (paper, section 3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum WireModel {
+    /// Rectangular wire: torque rotates about the crown centre, force translates bodily.
+    #[default]
+    Rectangular,
+    /// Round wire: force tips the tooth about a centre at 1/3 of the root length from the apex.
+    Round,
+}
+
+/// Wire models per arch, with optional per-tooth exceptions.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseWires {
+    /// Upper arch wire.
+    #[serde(default)]
+    pub upper: WireModel,
+    /// Lower arch wire.
+    #[serde(default)]
+    pub lower: WireModel,
+    /// Per-tooth exceptions.
+    #[serde(default)]
+    pub teeth: ToothMap<WireModel>,
+}
+
+/// Degrees of freedom along or about the anatomical axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Freedoms {
+    /// Along / about the mesiodistal axis.
+    #[serde(default = "yes")]
+    pub mesial: bool,
+    /// Along / about the buccolingual axis.
+    #[serde(default = "yes")]
+    pub buccal: bool,
+    /// Along / about the long (occlusal) axis.
+    #[serde(default = "yes")]
+    pub occlusal: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl Default for Freedoms {
+    fn default() -> Self {
+        Self {
+            mesial: true,
+            buccal: true,
+            occlusal: true,
+        }
+    }
+}
+
+/// Movement constraints on some teeth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseConstraint {
+    /// The constrained teeth.
+    pub teeth: ToothList,
+    /// Allowed translations.
+    #[serde(default)]
+    pub translate: Freedoms,
+    /// Allowed rotations.
+    #[serde(default)]
+    pub rotate: Freedoms,
+    /// Largest total translation from the start pose (mm).
+    #[serde(default)]
+    pub max_translation_mm: Option<NonNegative>,
+    /// Largest total rotation from the start pose (degrees).
+    #[serde(default)]
+    pub max_rotation_deg: Option<NonNegative>,
+}
+
+/// A tooth's displacement from its place in the normal arch, in its anatomical frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseOffset {
+    /// Translation (mm) along mesial, buccal, occlusal.
+    #[serde(default)]
+    pub translation: (Finite, Finite, Finite),
+    /// Rotation (degrees) about the mesial (torque), buccal (tip) and occlusal (rotation) axes,
+    /// about the crown centre.
+    #[serde(default)]
+    pub rotation_deg: (Finite, Finite, Finite),
+}
+
+/// Which teeth the patient has.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum PresentTeeth {
+    /// All 32.
+    #[default]
+    All,
+    /// Only these (others are absent: not modelled at all).
+    Only(ToothList),
+    /// All but these.
+    AllBut(ToothList),
+}
+
+/// A patient case as read from RON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Short name.
+    pub name: String,
+    /// What the case shows.
+    #[serde(default)]
+    pub description: String,
+    /// Vertices per procedural tooth (default 125).
+    #[serde(default)]
+    pub resolution: Option<u32>,
+    /// Teeth present in the mouth.
+    #[serde(default)]
+    pub teeth: PresentTeeth,
+    /// Extracted teeth (present in the data, hidden, skipped by the simulation).
+    #[serde(default)]
+    pub extracted: ToothList,
+    /// Extra space (mm) opened on the mesial side of a tooth, e.g. a diastema: `{21: 3.0}` opens
+    /// 3 mm between 11 and 21. The arch is rebuilt with the space.
+    #[serde(default)]
+    pub spaces: ToothMap<NonNegative>,
+    /// Per-tooth displacements from the arch.
+    #[serde(default)]
+    pub offsets: ToothMap<CaseOffset>,
+    /// Loads.
+    #[serde(default)]
+    pub loads: Vec<CaseLoad>,
+    /// Archwires.
+    #[serde(default)]
+    pub wire: CaseWires,
+    /// Movement constraints.
+    #[serde(default)]
+    pub constraints: Vec<CaseConstraint>,
+    /// Mesh files per tooth, relative to the case file (mesh import is a later feature).
+    #[serde(default)]
+    pub meshes: ToothMap<String>,
+}
+
+/// A case with where it came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedCase {
+    /// The case.
+    pub case: Case,
+    /// File path or `builtin:NAME`.
+    pub origin: String,
+    /// The source text.
+    pub source: String,
+}
+
+impl Case {
+    /// Names of the built-in cases.
+    pub fn builtin_names() -> impl Iterator<Item = &'static str> {
+        BUILTIN_CASES.iter().map(|(n, _)| *n)
+    }
+
+    /// Loads a built-in case by name, or a .ron file by path.
+    pub fn resolve(name_or_path: &str) -> Result<LoadedCase, CaseError> {
+        if let Some((name, src)) = BUILTIN_CASES.iter().find(|(n, _)| *n == name_or_path) {
+            return Self::parse(src, &format!("builtin:{name}"));
+        }
+        let path = Path::new(name_or_path);
+        if path.exists() || name_or_path.ends_with(".ron") {
+            return Self::load(path);
+        }
+        Err(CaseError::Unknown(name_or_path.to_owned()))
+    }
+
+    /// Reads and validates a case file.
+    pub fn load(path: &Path) -> Result<LoadedCase, CaseError> {
+        let origin = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| CaseError::Io {
+            path: origin.clone(),
+            message: e.to_string(),
+        })?;
+        let source = String::from_utf8(bytes).map_err(|e| {
+            let before = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = before.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+            CaseError::Invalid {
+                path: origin.clone(),
+                line,
+                column,
+                message: "file is not valid UTF-8 text".into(),
+            }
+        })?;
+        Self::parse(&source, &origin)
+    }
+
+    /// Parses and validates case text; `origin` names it in errors.
+    pub fn parse(source: &str, origin: &str) -> Result<LoadedCase, CaseError> {
+        let invalid = |line: usize, column: usize, message: String| CaseError::Invalid {
+            path: origin.to_owned(),
+            line,
+            column,
+            message,
+        };
+        if source.trim().is_empty() {
+            return Err(invalid(1, 1, "case file is empty".into()));
+        }
+        let case: Case = ron::Options::default()
+            .from_str(source)
+            .map_err(|e| invalid(e.span.start.line, e.span.start.col, e.code.to_string()))?;
+        case.check().map_err(|(field, token, message)| {
+            let (line, column) = locate(source, field, token.as_deref());
+            invalid(line, column, message)
+        })?;
+        Ok(LoadedCase {
+            case,
+            origin: origin.to_owned(),
+            source: source.to_owned(),
+        })
+    }
+
+    /// The teeth present in the mouth (extracted ones included).
+    pub fn present(&self) -> Vec<Fdi> {
+        Fdi::all()
+            .filter(|f| match &self.teeth {
+                PresentTeeth::All => true,
+                PresentTeeth::Only(l) => l.0.contains(f),
+                PresentTeeth::AllBut(l) => !l.0.contains(f),
+            })
+            .collect()
+    }
+
+    /// True when the tooth is present and extracted.
+    pub fn is_extracted(&self, f: Fdi) -> bool {
+        self.extracted.0.contains(&f)
+    }
+
+    /// The mesh resolution asked for.
+    pub fn tooth_resolution(&self) -> ToothResolution {
+        self.resolution.map_or(ToothResolution::PAPER, |vertices| ToothResolution { vertices })
+    }
+
+    /// The wire model of a tooth.
+    pub fn wire_of(&self, f: Fdi) -> WireModel {
+        self.wire.teeth.0.get(&f).copied().unwrap_or(match f.arch() {
+            super::fdi::Arch::Upper => self.wire.upper,
+            super::fdi::Arch::Lower => self.wire.lower,
+        })
+    }
+
+    /// Cross-field checks: (field, offending token, message).
+    fn check(&self) -> Result<(), (&'static str, Option<String>, String)> {
+        let present = self.present();
+        if let Some(r) = self.resolution {
+            if !(20..=200_000).contains(&r) {
+                return Err(("resolution", Some(r.to_string()), format!("resolution must be 20–200000 vertices, got {r}")));
+            }
+        }
+        for f in &self.extracted.0 {
+            if !present.contains(f) {
+                return Err(("extracted", Some(f.to_string()), format!("tooth {f} is extracted but not present")));
+            }
+        }
+        let absent = |field: &'static str, f: &Fdi| -> Result<(), (&'static str, Option<String>, String)> {
+            if !present.contains(f) {
+                Err((field, Some(f.to_string()), format!("tooth {f} is not present in this case")))
+            } else {
+                Ok(())
+            }
+        };
+        for f in self.spaces.0.keys() {
+            absent("spaces", f)?;
+        }
+        for f in self.offsets.0.keys() {
+            absent("offsets", f)?;
+        }
+        for f in self.meshes.0.keys() {
+            absent("meshes", f)?;
+        }
+        if let Some(f) = self.meshes.0.keys().next() {
+            return Err((
+                "meshes",
+                Some(f.to_string()),
+                "per-tooth mesh files are not supported yet; remove `meshes` to use procedural teeth".into(),
+            ));
+        }
+        for load in &self.loads {
+            if load.teeth.0.is_empty() {
+                return Err(("loads", None, "a load must name at least one tooth".into()));
+            }
+            for f in &load.teeth.0 {
+                absent("loads", f)?;
+                if self.is_extracted(*f) {
+                    return Err(("loads", Some(f.to_string()), format!("load on extracted tooth {f}")));
+                }
+            }
+            let (fm, tm) = (load.force.magnitude(), load.torque.magnitude());
+            if fm > MAX_FORCE_N {
+                return Err(("force", None, format!("force of {fm:.1} N is beyond the {MAX_FORCE_N} N accepted")));
+            }
+            if tm > MAX_TORQUE_NMM {
+                return Err(("torque", None, format!("torque of {tm:.1} N·mm is beyond the {MAX_TORQUE_NMM} N·mm accepted")));
+            }
+        }
+        for c in &self.constraints {
+            for f in &c.teeth.0 {
+                absent("constraints", f)?;
+            }
+        }
+        for f in self.wire.teeth.0.keys() {
+            absent("wire", f)?;
+        }
+        Ok(())
+    }
+}
+
+/// 1-based (line, column) of `token` (a whole word) after the field name `field:`; of the field
+/// itself when the token is not found; (1, 1) when neither is.
+fn locate(source: &str, field: &str, token: Option<&str>) -> (usize, usize) {
+    let is_word = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let find_word = |from: usize, word: &str| -> Option<usize> {
+        let mut start = from;
+        while let Some(i) = source[start..].find(word) {
+            let at = start + i;
+            let before = source[..at].chars().next_back();
+            let after = source[at + word.len()..].chars().next();
+            if !before.is_some_and(is_word) && !after.is_some_and(is_word) {
+                return Some(at);
+            }
+            start = at + word.len();
+        }
+        None
+    };
+    let field_at = find_word(0, field);
+    let at = match (field_at, token) {
+        (Some(f), Some(t)) => find_word(f, t).or(Some(f)),
+        (f, _) => f,
+    };
+    let Some(at) = at else { return (1, 1) };
+    let line = source[..at].matches('\n').count() + 1;
+    let column = source[..at].rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(src: &str) -> (usize, usize, String) {
+        match Case::parse(src, "t.ron") {
+            Err(CaseError::Invalid {
+                line,
+                column,
+                message,
+                ..
+            }) => (line, column, message),
+            other => panic!("expected an error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn builtin_cases_parse() {
+        for name in Case::builtin_names() {
+            let c = Case::resolve(name).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(c.case.name, name);
+        }
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  extracted: [14, 19],\n)");
+        assert_eq!(l, 3, "{m}");
+        assert!(m.contains("19"), "{m}");
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  extracted: [14, 14],\n)");
+        assert_eq!(l, 3);
+        assert!(m.contains("duplicate"), "{m}");
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  colour: 3,\n)");
+        assert_eq!(l, 3);
+        assert!(m.contains("colour"), "{m}");
+        let (l, c, m) = err("Case(\n  name: \"x\",\n  extracted: [14],\n  loads: [(teeth: [16, 14], force: World(0.0, 0.0, 1.0))],\n)");
+        assert_eq!((l, c), (4, 24), "{m}");
+        assert!(m.contains("extracted tooth 14"), "{m}");
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  loads: [(teeth: [16],\n    force: World(0.0, NaN, 1.0))],\n)");
+        assert_eq!(l, 4);
+        assert!(m.contains("finite"), "{m}");
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  spaces: {21: -2.0},\n)");
+        assert_eq!(l, 3);
+        assert!(m.contains("negative"), "{m}");
+        let (l, _, m) = err("Case(\n  name: \"x\",\n  offsets: {11: (), 11: ()},\n)");
+        assert_eq!(l, 3);
+        assert!(m.contains("duplicate"), "{m}");
+        let (_, _, m) = err("Case(name: \"x\", loads: [(teeth: [16], force: World(0.0, 0.0, 1e9))])");
+        assert!(m.contains("beyond"), "{m}");
+        let (l, c, m) = err("");
+        assert_eq!((l, c), (1, 1));
+        assert!(m.contains("empty"));
+        let (l, _, _) = err("Case(\n  name: \"x\"\n  extracted: [14],\n)");
+        assert_eq!(l, 3, "missing comma");
+    }
+
+    #[test]
+    fn unknown_names_are_refused() {
+        assert!(matches!(Case::resolve("nope"), Err(CaseError::Unknown(_))));
+        assert!(matches!(Case::resolve("/no/such/file.ron"), Err(CaseError::Io { .. })));
+    }
+}

@@ -1,0 +1,180 @@
+//! `Dentition`: a patient case turned into placed teeth (engine-free), ready for spawning,
+//! inspection and analysis.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+
+use super::{
+    arch::{Arrangement, OcclusionMeasures, Spaces},
+    case::{CaseError, CaseVector, LoadedCase, WireModel},
+    fdi::{Arch, Fdi},
+    tooth_shape::{ShapeSet, ToothGeometry},
+};
+use crate::geometry::Pose;
+
+/// One tooth of a case, placed in the world frame.
+#[derive(Clone, Debug)]
+pub struct PlacedTooth {
+    /// FDI number.
+    pub fdi: Fdi,
+    /// Shared geometry.
+    pub geometry: Arc<ToothGeometry>,
+    /// Pose of the local frame.
+    pub pose: Pose,
+    /// True for an extracted tooth (kept in the data, hidden and skipped by the simulation).
+    pub extracted: bool,
+    /// Net force on the tooth from the case's individual loads (N, world frame).
+    pub force: Vec3,
+    /// Net torque from the case's individual loads (N·mm, world frame).
+    pub torque: Vec3,
+    /// Index into [`Dentition::groups`] when the tooth is loaded as part of a group.
+    pub group: Option<usize>,
+    /// Wire model.
+    pub wire: WireModel,
+}
+
+impl PlacedTooth {
+    /// Unit mesial, buccal and occlusal directions in the world frame.
+    pub fn anatomical_axes(&self) -> [Vec3; 3] {
+        let r = self.pose.rotation;
+        [
+            r * (Vec3::X * self.fdi.local_x_mesial_sign()),
+            r * Vec3::Z,
+            r * Vec3::Y,
+        ]
+    }
+
+    /// A case vector in the world frame.
+    pub fn world_vector(&self, v: &CaseVector) -> Vec3 {
+        match *v {
+            CaseVector::World(x, y, z) => Vec3::new(x.0, y.0, z.0),
+            CaseVector::Anatomical {
+                mesial,
+                buccal,
+                occlusal,
+            } => {
+                let [m, b, o] = self.anatomical_axes();
+                m * mesial.0 + b * buccal.0 + o * occlusal.0
+            }
+        }
+    }
+
+    /// The crown centre in the world frame.
+    pub fn crown_centre(&self) -> Vec3 {
+        self.pose.transform_point(self.geometry.frame.crown_centre)
+    }
+}
+
+/// A load applied to a group of teeth moving as one block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupLoad {
+    /// Members.
+    pub teeth: Vec<Fdi>,
+    /// Force (N, world frame), resolved in the first member's frame when anatomical.
+    pub force: Vec3,
+    /// Torque (N·mm, world frame).
+    pub torque: Vec3,
+}
+
+/// The teeth of a case placed in the world frame.
+#[derive(Clone, Debug)]
+pub struct Dentition {
+    /// The case it was built from.
+    pub case: Arc<LoadedCase>,
+    /// Present teeth in FDI order (extracted ones included, flagged).
+    pub teeth: Vec<PlacedTooth>,
+    /// Group loads.
+    pub groups: Vec<GroupLoad>,
+    /// Occlusion measures of the underlying arrangement (before offsets).
+    pub arrangement: OcclusionMeasures,
+}
+
+impl Dentition {
+    /// Places the teeth of a validated case.
+    pub fn build(loaded: LoadedCase) -> Result<Self, CaseError> {
+        let case = &loaded.case;
+        let shapes = ShapeSet::shared(case.tooth_resolution());
+        let spaces: Spaces = case.spaces.0.iter().map(|(f, s)| (*f, s.0)).collect();
+        let arrangement = Arrangement::shared(&shapes, &spaces);
+        let mut teeth: Vec<PlacedTooth> = case
+            .present()
+            .into_iter()
+            .map(|fdi| PlacedTooth {
+                fdi,
+                geometry: shapes.get(fdi.arch(), fdi.kind()),
+                pose: arrangement.pose(fdi),
+                extracted: case.is_extracted(fdi),
+                force: Vec3::ZERO,
+                torque: Vec3::ZERO,
+                group: None,
+                wire: case.wire_of(fdi),
+            })
+            .collect();
+        for tooth in &mut teeth {
+            if let Some(offset) = case.offsets.0.get(&tooth.fdi) {
+                let [m, b, o] = tooth.anatomical_axes();
+                let (t, r) = (offset.translation, offset.rotation_deg);
+                let rotation = Quat::from_axis_angle(m, r.0 .0.to_radians())
+                    * Quat::from_axis_angle(b, r.1 .0.to_radians())
+                    * Quat::from_axis_angle(o, r.2 .0.to_radians());
+                let pivot = tooth.crown_centre();
+                let about_pivot = Pose::from_translation(pivot)
+                    .mul(&Pose::new(rotation, Vec3::ZERO))
+                    .mul(&Pose::from_translation(-pivot));
+                let shift = Pose::from_translation(m * t.0 .0 + b * t.1 .0 + o * t.2 .0);
+                tooth.pose = shift.mul(&about_pivot).mul(&tooth.pose);
+            }
+        }
+        let mut groups = Vec::new();
+        for load in &case.loads {
+            if load.as_group {
+                let first = teeth
+                    .iter()
+                    .find(|t| t.fdi == load.teeth.0[0])
+                    .expect("validated: loaded teeth are present");
+                groups.push(GroupLoad {
+                    teeth: load.teeth.0.clone(),
+                    force: first.world_vector(&load.force),
+                    torque: first.world_vector(&load.torque),
+                });
+                for t in teeth.iter_mut().filter(|t| load.teeth.0.contains(&t.fdi)) {
+                    t.group = Some(groups.len() - 1);
+                }
+            } else {
+                for t in teeth.iter_mut().filter(|t| load.teeth.0.contains(&t.fdi)) {
+                    t.force += t.world_vector(&load.force);
+                    t.torque += t.world_vector(&load.torque);
+                }
+            }
+        }
+        Ok(Self {
+            case: Arc::new(loaded),
+            teeth,
+            groups,
+            arrangement: arrangement.measures,
+        })
+    }
+
+    /// A tooth by number.
+    pub fn tooth(&self, fdi: Fdi) -> Option<&PlacedTooth> {
+        self.teeth.iter().find(|t| t.fdi == fdi)
+    }
+
+    /// Teeth that are present and not extracted.
+    pub fn visible(&self) -> impl Iterator<Item = &PlacedTooth> {
+        self.teeth.iter().filter(|t| !t.extracted)
+    }
+
+    /// Adjacent visible teeth along each arch, from the patient's right to left; extracted or
+    /// absent teeth are skipped, so their neighbours pair up across the space.
+    pub fn neighbour_pairs(&self) -> Vec<(Fdi, Fdi)> {
+        let mut pairs = Vec::new();
+        for arch in [Arch::Upper, Arch::Lower] {
+            let mut row: Vec<&PlacedTooth> = self.visible().filter(|t| t.fdi.arch() == arch).collect();
+            row.sort_by_key(|t| t.fdi.arch_index());
+            pairs.extend(row.windows(2).map(|w| (w[0].fdi, w[1].fdi)));
+        }
+        pairs
+    }
+}

@@ -1,0 +1,120 @@
+//! `ToothGeometry`: a tooth's mesh, its triangle hierarchy and its anatomical frame, shared by every
+//! tooth of the same type (mirrored teeth included) through an `Arc`.
+
+use std::{
+    collections::HashMap,
+    sync::{Arc, Mutex, OnceLock},
+};
+
+use glam::Vec3;
+
+use super::{
+    anatomy::{anatomy, ToothAnatomy},
+    fdi::{Arch, ToothKind},
+    frame::{CentreParameters, ToothFrame},
+    shape::{ToothResolution, ToothSolid},
+};
+use crate::geometry::{MeshRef, TriMesh, TriangleBvh};
+
+/// The geometry of one tooth in its local frame (see [`super::shape`] for the frame).
+#[derive(Debug)]
+pub struct ToothGeometry {
+    /// Arch the shape was made for.
+    pub arch: Arch,
+    /// Tooth type.
+    pub kind: ToothKind,
+    /// Dimensions it was made from.
+    pub anatomy: ToothAnatomy,
+    /// Closed, outward-wound surface (mm).
+    pub mesh: TriMesh,
+    /// Triangle hierarchy for exact queries.
+    pub bvh: TriangleBvh,
+    /// Data computed from the mesh.
+    pub frame: ToothFrame,
+    /// Cusp tips and incisal points in the local frame (for occlusion measures).
+    pub cusp_tips: Vec<Vec3>,
+}
+
+impl ToothGeometry {
+    /// Builds the procedural shape of a tooth type.
+    pub fn procedural(arch: Arch, kind: ToothKind, resolution: ToothResolution) -> Self {
+        let an = anatomy(arch, kind);
+        let solid = ToothSolid::new(arch, kind, an);
+        let mesh = solid.mesh(resolution);
+        let frame = ToothFrame::from_mesh(&mesh, Vec3::ZERO, Vec3::Y, Vec3::Z, CentreParameters::default());
+        let bvh = TriangleBvh::build(&mesh);
+        Self {
+            arch,
+            kind,
+            anatomy: an,
+            cusp_tips: solid.cusp_tips(),
+            mesh,
+            bvh,
+            frame,
+        }
+    }
+
+    /// The mesh with its hierarchy, for geometry queries.
+    pub fn mesh_ref(&self) -> MeshRef<'_> {
+        MeshRef {
+            mesh: &self.mesh,
+            bvh: &self.bvh,
+        }
+    }
+}
+
+/// The sixteen procedural shapes (8 kinds × 2 arches) at one resolution.
+#[derive(Debug)]
+pub struct ShapeSet {
+    /// Resolution of every shape.
+    pub resolution: ToothResolution,
+    shapes: Vec<Arc<ToothGeometry>>,
+}
+
+impl ShapeSet {
+    /// The shape of a tooth type.
+    pub fn get(&self, arch: Arch, kind: ToothKind) -> Arc<ToothGeometry> {
+        let i = match arch {
+            Arch::Upper => 0,
+            Arch::Lower => 8,
+        } + kind as usize;
+        self.shapes[i].clone()
+    }
+
+    /// Builds all sixteen shapes, on all cores.
+    fn build(resolution: ToothResolution) -> Self {
+        let jobs: Vec<(Arch, ToothKind)> = [Arch::Upper, Arch::Lower]
+            .into_iter()
+            .flat_map(|a| ToothKind::ALL.into_iter().map(move |k| (a, k)))
+            .collect();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(jobs.len());
+        let mut slots: Vec<Option<Arc<ToothGeometry>>> = vec![None; jobs.len()];
+        std::thread::scope(|scope| {
+            let chunks: Vec<_> = slots
+                .chunks_mut(jobs.len().div_ceil(threads))
+                .zip(jobs.chunks(jobs.len().div_ceil(threads)))
+                .collect();
+            for (out, work) in chunks {
+                scope.spawn(move || {
+                    for (slot, &(arch, kind)) in out.iter_mut().zip(work) {
+                        *slot = Some(Arc::new(ToothGeometry::procedural(arch, kind, resolution)));
+                    }
+                });
+            }
+        });
+        Self {
+            resolution,
+            shapes: slots.into_iter().flatten().collect(),
+        }
+    }
+
+    /// The shared set for a resolution, built once per process.
+    pub fn shared(resolution: ToothResolution) -> Arc<ShapeSet> {
+        static CACHE: OnceLock<Mutex<HashMap<ToothResolution, Arc<OnceLock<Arc<ShapeSet>>>>>> = OnceLock::new();
+        let cell = {
+            let mut map = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+            map.entry(resolution).or_default().clone()
+        };
+        cell.get_or_init(|| Arc::new(Self::build(resolution))).clone()
+    }
+}
