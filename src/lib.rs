@@ -41,11 +41,11 @@ impl PluginGroup for OrthoSimPlugins {
 /// The most used types.
 pub mod prelude {
     pub use crate::{
+        OrthoSimPlugins,
         geometry::{Pose, TriMesh},
         teeth::{
-            ActiveCase, Arch, Case, CaseLoaded, Extracted, Fdi, LoadCase, Load, TeethModelPlugin, Tooth,
-            ToothKind, ToothShape,
+            ActiveCase, Arch, Case, CaseLoaded, Extracted, Fdi, Load, LoadCase, TeethModelPlugin,
+            Tooth, ToothKind, ToothShape,
         },
-        OrthoSimPlugins,
     };
 }

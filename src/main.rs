@@ -24,6 +24,10 @@ enum Command {
         /// Built-in case name or path to a .ron case file.
         #[arg(long, default_value = "normal")]
         case: String,
+        /// Camera view at start-up (keys 1–5 switch views in the window).
+        #[cfg(feature = "viewer")]
+        #[arg(long, value_enum, default_value_t = orthosim::occlusion_view::CameraPreset::Frontal)]
+        camera: orthosim::occlusion_view::CameraPreset,
     },
     /// List the built-in cases, one line each.
     Cases,
@@ -40,9 +44,16 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command.unwrap_or(Command::View {
+    // No subcommand: the viewer on the default case.
+    let command = cli.command.unwrap_or(Command::View {
         case: "normal".into(),
-    }) {
+        #[cfg(feature = "viewer")]
+        camera: Default::default(),
+    });
+    let result = match command {
+        #[cfg(feature = "viewer")]
+        Command::View { case, camera } => view(&case, camera),
+        #[cfg(not(feature = "viewer"))]
         Command::View { case } => view(&case),
         Command::Cases => {
             list_cases();
@@ -71,11 +82,20 @@ fn run_inspect(case: &str, json: bool) -> Result<()> {
     let dentition = Dentition::build(loaded)?;
     let report = inspect(&dentition);
     if json {
-        println!("{}", serde_json::to_string_pretty(&report).context("writing JSON")?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).context("writing JSON")?
+        );
         return Ok(());
     }
-    println!("case {} ({}), {} vertices per tooth", report.case, report.origin, report.resolution);
-    println!("{:>4} {:<16} {:<6} {:>5} {:>5} {:>7} {:>9}  crown centre (mm)", "fdi", "kind", "arch", "verts", "tris", "closed", "vol mm3");
+    println!(
+        "case {} ({}), {} vertices per tooth",
+        report.case, report.origin, report.resolution
+    );
+    println!(
+        "{:>4} {:<16} {:<6} {:>5} {:>5} {:>7} {:>9}  crown centre (mm)",
+        "fdi", "kind", "arch", "verts", "tris", "closed", "vol mm3"
+    );
     for t in &report.teeth {
         let c = t.crown_centre;
         println!(
@@ -97,7 +117,10 @@ fn run_inspect(case: &str, json: bool) -> Result<()> {
     for g in &report.neighbour_gaps_mm {
         println!("  {}-{}: {:.3}", g.a, g.b, g.gap_mm);
     }
-    println!("max penetration in an arch: {:.4} mm", report.max_penetration_mm);
+    println!(
+        "max penetration in an arch: {:.4} mm",
+        report.max_penetration_mm
+    );
     println!(
         "max penetration between arches: {:.4} mm (least gap {:.4} mm)",
         report.occlusal_max_penetration_mm, report.occlusal_min_gap_mm
@@ -111,9 +134,9 @@ fn run_inspect(case: &str, json: bool) -> Result<()> {
 }
 
 #[cfg(feature = "viewer")]
-fn view(case: &str) -> Result<()> {
+fn view(case: &str, camera: orthosim::occlusion_view::CameraPreset) -> Result<()> {
     use bevy::prelude::*;
-    use orthosim::{occlusion_view::OcclusionViewPlugin, teeth::TeethModelPlugin, OrthoSimPlugins};
+    use orthosim::{OrthoSimPlugins, occlusion_view::OcclusionViewPlugin, teeth::TeethModelPlugin};
     // Fail early, with the file position, before a window opens.
     Case::resolve(case)?;
     App::new()
@@ -127,12 +150,16 @@ fn view(case: &str) -> Result<()> {
         .add_plugins(OrthoSimPlugins.set(TeethModelPlugin {
             initial_case: Some(case.to_owned()),
         }))
-        .add_plugins(OcclusionViewPlugin)
+        .add_plugins(OcclusionViewPlugin {
+            initial_view: camera,
+        })
         .run();
     Ok(())
 }
 
 #[cfg(not(feature = "viewer"))]
 fn view(_case: &str) -> Result<()> {
-    anyhow::bail!("this build has no viewer (built without the `viewer` feature); use a headless subcommand, see --help")
+    anyhow::bail!(
+        "this build has no viewer (built without the `viewer` feature); use a headless subcommand, see --help"
+    )
 }

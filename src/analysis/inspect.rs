@@ -7,8 +7,8 @@
 use serde::Serialize;
 
 use crate::{
-    geometry::{mesh_separation, TriMesh},
-    teeth::{arch::OcclusionMeasures, Dentition, PlacedTooth},
+    geometry::{TriMesh, mesh_separation},
+    teeth::{Dentition, PlacedTooth, arch::OcclusionMeasures},
 };
 
 /// One tooth's line of the report.
@@ -72,7 +72,13 @@ pub struct InspectReport {
 }
 
 fn signed_gap(a: &PlacedTooth, b: &PlacedTooth) -> f32 {
-    mesh_separation(a.geometry.mesh_ref(), &a.pose, b.geometry.mesh_ref(), &b.pose).signed_gap()
+    mesh_separation(
+        a.geometry.mesh_ref(),
+        &a.pose,
+        b.geometry.mesh_ref(),
+        &b.pose,
+    )
+    .signed_gap()
 }
 
 /// Reports on mesh `m`'s validity.

@@ -2,4 +2,4 @@
 
 pub mod inspect;
 
-pub use inspect::{inspect, InspectReport};
+pub use inspect::{InspectReport, inspect};

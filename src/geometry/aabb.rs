@@ -72,7 +72,11 @@ impl Aabb {
     pub fn transformed(&self, rotation: &Mat3, translation: Vec3) -> Self {
         let c = *rotation * self.centre() + translation;
         let h = self.extent() * 0.5;
-        let abs = Mat3::from_cols(rotation.x_axis.abs(), rotation.y_axis.abs(), rotation.z_axis.abs());
+        let abs = Mat3::from_cols(
+            rotation.x_axis.abs(),
+            rotation.y_axis.abs(),
+            rotation.z_axis.abs(),
+        );
         let r = abs * h;
         Self {
             min: c - r,

@@ -141,7 +141,9 @@ impl TriangleBvh {
                     let l = na.start;
                     stack.extend([(l, l), (l + 1, l + 1), (l, l + 1)]);
                 }
-                (false, _) if nb.is_leaf() || na.aabb.extent().length() >= nb.aabb.extent().length() => {
+                (false, _)
+                    if nb.is_leaf() || na.aabb.extent().length() >= nb.aabb.extent().length() =>
+                {
                     stack.extend([(na.start, b), (na.start + 1, b)]);
                 }
                 _ => stack.extend([(a, nb.start), (a, nb.start + 1)]),

@@ -1,14 +1,20 @@
 //! Exact closest-point and intersection queries between points, segments and triangles
 //! (after Ericson, *Real-Time Collision Detection*, 5.1.5, 5.1.9 and 4.4 / 5.2).
 //!
-//! Guarantees: the closest-point functions are exact up to floating-point rounding (f32, relative
-//! error about 1e-6 of the coordinates' magnitude). [`triangles_intersect`] is a separating-axis test
+//! Guarantees: the closest-point functions are exact up to floating-point rounding (computed in
+//! f64, returned in f32: about 1e-7 of the coordinates' magnitude), sliver triangles included. [`triangles_intersect`] is a separating-axis test
 //! that treats touching triangles as intersecting.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
-/// The closest point to `p` on the triangle `a b c` (Ericson 5.1.5, Voronoi regions).
+/// The closest point to `p` on the triangle `a b c` (Ericson 5.1.5, Voronoi regions), computed in
+/// f64 so that sliver triangles stay accurate.
 pub fn closest_point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let [p, a, b, c] = [p, a, b, c].map(|v| v.as_dvec3());
+    closest_point_triangle_f64(p, a, b, c).as_vec3()
+}
+
+fn closest_point_triangle_f64(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;
@@ -44,16 +50,34 @@ pub fn closest_point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
         return b + (c - b) * w;
     }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
+    let sum = va + vb + vc;
+    if sum.abs() <= f64::MIN_POSITIVE {
+        // A degenerate triangle: the nearest of its edges.
+        return [(a, b), (b, c), (c, a)]
+            .into_iter()
+            .map(|(s, e)| closest_point_segment_f64(p, s, e))
+            .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+            .unwrap_or(a);
+    }
+    let v = vb / sum;
+    let w = vc / sum;
     a + ab * v + ac * w
 }
 
+fn closest_point_segment_f64(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let d = b - a;
+    let len2 = d.length_squared();
+    if len2 <= f64::MIN_POSITIVE {
+        return a;
+    }
+    a + d * ((p - a).dot(d) / len2).clamp(0.0, 1.0)
+}
+
 /// Closest points between segments `p1 q1` and `p2 q2` (Ericson 5.1.9), degenerate segments
-/// included. Returns the two points.
+/// included, computed in f64. Returns the two points.
 pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> (Vec3, Vec3) {
-    const EPS: f32 = 1e-12;
+    const EPS: f64 = 1e-18;
+    let [p1, q1, p2, q2] = [p1, q1, p2, q2].map(|v| v.as_dvec3());
     let d1 = q1 - p1;
     let d2 = q2 - p2;
     let r = p1 - p2;
@@ -62,7 +86,7 @@ pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) ->
     let f = d2.dot(r);
     let (s, t);
     if a <= EPS && e <= EPS {
-        return (p1, p2);
+        return (p1.as_vec3(), p2.as_vec3());
     }
     if a <= EPS {
         s = 0.0;
@@ -75,7 +99,7 @@ pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) ->
         } else {
             let b = d1.dot(d2);
             let denom = a * e - b * b;
-            let s0 = if denom > EPS * a * e {
+            let s0 = if denom > 1e-12 * a * e {
                 ((b * f - c * e) / denom).clamp(0.0, 1.0)
             } else {
                 0.0
@@ -93,7 +117,7 @@ pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) ->
             }
         }
     }
-    (p1 + d1 * s, p2 + d2 * t)
+    ((p1 + d1 * s).as_vec3(), (p2 + d2 * t).as_vec3())
 }
 
 /// Closest points between two triangles and their distance.
@@ -135,7 +159,8 @@ pub fn triangles_intersect(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> bool {
     if separated(n1) || separated(n2) {
         return false;
     }
-    let coplanar = n1.cross(n2).length_squared() <= 1e-10 * n1.length_squared() * n2.length_squared();
+    let coplanar =
+        n1.cross(n2).length_squared() <= 1e-10 * n1.length_squared() * n2.length_squared();
     if coplanar {
         for e in e1 {
             if separated(n1.cross(e)) {
@@ -224,7 +249,8 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
     }
     for i in 0..3 {
         for j in 0..3 {
-            let (a, b) = closest_points_segment_segment(t1[i], t1[(i + 1) % 3], t2[j], t2[(j + 1) % 3]);
+            let (a, b) =
+                closest_points_segment_segment(t1[i], t1[(i + 1) % 3], t2[j], t2[(j + 1) % 3]);
             consider(a, b);
         }
     }
@@ -246,11 +272,23 @@ mod tests {
     fn point_triangle_regions() {
         let [a, b, c] = tri([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         let inside = closest_point_triangle(Vec3::new(0.2, 0.2, 3.0), a, b, c);
-        assert!((inside - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-6, "{inside}");
-        assert_eq!(closest_point_triangle(Vec3::new(-1.0, -1.0, 0.0), a, b, c), a);
-        assert_eq!(closest_point_triangle(Vec3::new(2.0, -0.5, 0.0), a, b, c), b);
+        assert!(
+            (inside - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-6,
+            "{inside}"
+        );
+        assert_eq!(
+            closest_point_triangle(Vec3::new(-1.0, -1.0, 0.0), a, b, c),
+            a
+        );
+        assert_eq!(
+            closest_point_triangle(Vec3::new(2.0, -0.5, 0.0), a, b, c),
+            b
+        );
         let on_edge = closest_point_triangle(Vec3::new(0.5, -2.0, 1.0), a, b, c);
-        assert!((on_edge - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6, "{on_edge}");
+        assert!(
+            (on_edge - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6,
+            "{on_edge}"
+        );
         let on_hyp = closest_point_triangle(Vec3::new(1.0, 1.0, 0.0), a, b, c);
         assert!((on_hyp - Vec3::new(0.5, 0.5, 0.0)).length() < 1e-6);
     }
@@ -264,7 +302,8 @@ mod tests {
             Vec3::new(2.0, 1.0, 0.0),
         );
         assert!((a.distance(b) - 1.0).abs() < 1e-6);
-        let (a, b) = closest_points_segment_segment(Vec3::ONE, Vec3::ONE, Vec3::ZERO, Vec3::X * 2.0);
+        let (a, b) =
+            closest_points_segment_segment(Vec3::ONE, Vec3::ONE, Vec3::ZERO, Vec3::X * 2.0);
         assert_eq!(a, Vec3::ONE);
         assert_eq!(b, Vec3::X);
     }

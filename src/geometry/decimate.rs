@@ -40,7 +40,18 @@ struct Quadric([f64; 10]);
 impl Quadric {
     fn plane(n: DVec3, d: f64) -> Self {
         let (a, b, c) = (n.x, n.y, n.z);
-        Self([a * a, a * b, a * c, a * d, b * b, b * c, b * d, c * c, c * d, d * d])
+        Self([
+            a * a,
+            a * b,
+            a * c,
+            a * d,
+            b * b,
+            b * c,
+            b * d,
+            c * c,
+            c * d,
+            d * d,
+        ])
     }
 
     fn add(&self, o: &Self) -> Self {
@@ -54,7 +65,10 @@ impl Quadric {
     fn error(&self, p: DVec3) -> f64 {
         let q = &self.0;
         let (x, y, z) = (p.x, p.y, p.z);
-        q[0] * x * x + 2.0 * q[1] * x * y + 2.0 * q[2] * x * z + 2.0 * q[3] * x
+        q[0] * x * x
+            + 2.0 * q[1] * x * y
+            + 2.0 * q[2] * x * z
+            + 2.0 * q[3] * x
             + q[4] * y * y
             + 2.0 * q[5] * y * z
             + 2.0 * q[6] * y
@@ -238,7 +252,11 @@ impl State {
             .map(|p| (self.cost(u, v, p), p))
             .collect();
         options.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let Some(p) = options.into_iter().map(|o| o.1).find(|&p| self.valid(u, v, p)) else {
+        let Some(p) = options
+            .into_iter()
+            .map(|o| o.1)
+            .find(|&p| self.valid(u, v, p))
+        else {
             return false;
         };
         for &f in &shared {
@@ -260,7 +278,10 @@ impl State {
             self.vertex_faces[w as usize].retain(|f| !shared.contains(f));
         }
         let faces = std::mem::take(&mut self.vertex_faces[u as usize]);
-        self.vertex_faces[u as usize] = faces.into_iter().filter(|&f| self.face_alive[f as usize]).collect();
+        self.vertex_faces[u as usize] = faces
+            .into_iter()
+            .filter(|&f| self.face_alive[f as usize])
+            .collect();
         self.vertex_faces[v as usize].clear();
         self.vertex_alive[v as usize] = false;
         self.pos[u as usize] = p;
@@ -270,7 +291,10 @@ impl State {
     }
 
     fn faces_of_edge_apexes(&self, shared: &[u32]) -> Vec<u32> {
-        shared.iter().flat_map(|&f| self.faces[f as usize]).collect()
+        shared
+            .iter()
+            .flat_map(|&f| self.faces[f as usize])
+            .collect()
     }
 
     /// Would moving u and v to p keep every surviving face well shaped and unflipped?
@@ -282,7 +306,13 @@ impl State {
                     continue;
                 }
                 let old = face.map(|i| self.pos[i as usize]);
-                let new = face.map(|i| if i == u || i == v { p } else { self.pos[i as usize] });
+                let new = face.map(|i| {
+                    if i == u || i == v {
+                        p
+                    } else {
+                        self.pos[i as usize]
+                    }
+                });
                 let n_old = (old[1] - old[0]).cross(old[2] - old[0]);
                 let n_new = (new[1] - new[0]).cross(new[2] - new[0]);
                 if n_new.dot(n_old) <= 0.2 * n_new.length() * n_old.length() {
@@ -294,7 +324,8 @@ impl State {
                 if let Some(c) = self.opts.star_centre {
                     let c = c.as_dvec3();
                     let det = (new[0] - c).dot((new[1] - c).cross(new[2] - c));
-                    let scale = (new[0] - c).length() * (new[1] - c).length() * (new[2] - c).length();
+                    let scale =
+                        (new[0] - c).length() * (new[1] - c).length() * (new[2] - c).length();
                     if det <= 1e-4 * scale {
                         return false;
                     }
@@ -327,7 +358,9 @@ impl State {
 /// Triangle quality: 4√3·area / (sum of squared edges); 1 for equilateral, 0 for degenerate.
 fn quality(t: &[DVec3; 3]) -> f64 {
     let area2 = (t[1] - t[0]).cross(t[2] - t[0]).length();
-    let edges = (t[1] - t[0]).length_squared() + (t[2] - t[1]).length_squared() + (t[0] - t[2]).length_squared();
+    let edges = (t[1] - t[0]).length_squared()
+        + (t[2] - t[1]).length_squared()
+        + (t[0] - t[2]).length_squared();
     if edges <= 0.0 {
         return 0.0;
     }
@@ -382,7 +415,11 @@ mod tests {
         );
         let r = out.validate_solid().unwrap();
         assert!(r.vertices <= 130, "{} vertices left", r.vertices);
-        assert!((r.volume - volume).abs() < 0.15 * volume, "{} vs {volume}", r.volume);
+        assert!(
+            (r.volume - volume).abs() < 0.15 * volume,
+            "{} vs {volume}",
+            r.volume
+        );
         for (i, t) in out.triangles.iter().enumerate() {
             let [a, b, c] = t.map(|k| out.vertices[k as usize]);
             assert!(a.dot(b.cross(c)) > 0.0, "triangle {i} faces the centre");

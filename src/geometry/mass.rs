@@ -41,7 +41,11 @@ impl MassProperties {
             first += det / 24.0 * (a + b + c);
             covariance += det * (m * canonical * m.transpose());
         }
-        let com = if volume.abs() > 0.0 { first / volume } else { DVec3::ZERO };
+        let com = if volume.abs() > 0.0 {
+            first / volume
+        } else {
+            DVec3::ZERO
+        };
         // Covariance about the centre of mass (parallel-axis theorem for covariance).
         let shifted = covariance - volume * outer(com, com);
         let inertia = DMat3::IDENTITY * trace(&shifted) - shifted;
@@ -125,7 +129,10 @@ mod tests {
     #[test]
     fn box_mass_properties_match_the_formulas() {
         let (w, h, d) = (2.0f32, 4.0f32, 6.0f32);
-        let mesh = cuboid(Vec3::new(1.0, -1.0, 3.0), Vec3::new(1.0 + w, -1.0 + h, 3.0 + d));
+        let mesh = cuboid(
+            Vec3::new(1.0, -1.0, 3.0),
+            Vec3::new(1.0 + w, -1.0 + h, 3.0 + d),
+        );
         let mp = MassProperties::of(&mesh);
         let vol = (w * h * d) as f64;
         assert!((mp.volume - vol).abs() < 1e-9);
@@ -136,12 +143,22 @@ mod tests {
             m / 12.0 * (w * w + d * d),
             m / 12.0 * (w * w + h * h),
         );
-        let diag = Vec3::new(mp.inertia.x_axis.x, mp.inertia.y_axis.y, mp.inertia.z_axis.z);
-        assert!((diag - expected).length() < 1e-3 * expected.length(), "{diag} vs {expected}");
+        let diag = Vec3::new(
+            mp.inertia.x_axis.x,
+            mp.inertia.y_axis.y,
+            mp.inertia.z_axis.z,
+        );
+        assert!(
+            (diag - expected).length() < 1e-3 * expected.length(),
+            "{diag} vs {expected}"
+        );
         assert!(mp.inertia.x_axis.y.abs() < 1e-3);
         let (moments, axes) = mp.principal_axes();
         assert!((moments.x - expected.z).abs() < 1e-2, "{moments}");
-        assert!(axes.x_axis.z.abs() > 0.999, "smallest moment is about the long (z) axis");
+        assert!(
+            axes.x_axis.z.abs() > 0.999,
+            "smallest moment is about the long (z) axis"
+        );
     }
 
     #[test]

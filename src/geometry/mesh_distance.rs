@@ -14,7 +14,7 @@ use glam::{Mat3, Vec3};
 use super::{
     aabb::Aabb,
     bvh::TriangleBvh,
-    closest::{closest_point_triangle, closest_points_triangle_triangle, TrianglePair},
+    closest::{TrianglePair, closest_point_triangle, closest_points_triangle_triangle},
     pose::Pose,
     trimesh::TriMesh,
 };
@@ -72,7 +72,11 @@ pub fn closest_triangles(
     // Work in a's frame: b_in_a = pose_a⁻¹ ∘ pose_b.
     let rel = pose_a.inverse().mul(pose_b);
     let rot = Mat3::from_quat(rel.rotation);
-    let bbox = |node: u32| b.bvh.nodes[node as usize].aabb.transformed(&rot, rel.translation);
+    let bbox = |node: u32| {
+        b.bvh.nodes[node as usize]
+            .aabb
+            .transformed(&rot, rel.translation)
+    };
     let mut best: Option<(TrianglePair, usize, usize)> = None;
     let mut best_d2 = if max_distance.is_finite() {
         max_distance * max_distance
@@ -167,7 +171,9 @@ pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
             let l = node.start;
             let (d0, d1) = (
                 m.bvh.nodes[l as usize].aabb.distance_squared_to_point(p),
-                m.bvh.nodes[l as usize + 1].aabb.distance_squared_to_point(p),
+                m.bvh.nodes[l as usize + 1]
+                    .aabb
+                    .distance_squared_to_point(p),
             );
             if d0 < d1 {
                 stack.extend([l + 1, l]);
@@ -299,8 +305,16 @@ pub fn mesh_separation(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> 
     MeshSeparation {
         distance: 0.0,
         penetration,
-        point_a: if penetration > 0.0 { point_a } else { pair.on_first },
-        point_b: if penetration > 0.0 { point_b } else { pair.on_second },
+        point_a: if penetration > 0.0 {
+            point_a
+        } else {
+            pair.on_first
+        },
+        point_b: if penetration > 0.0 {
+            point_b
+        } else {
+            pair.on_second
+        },
     }
 }
 
@@ -341,7 +355,10 @@ mod tests {
     #[test]
     fn separated_boxes_have_their_gap() {
         let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-        let r = MeshRef { mesh: &m, bvh: &bvh };
+        let r = MeshRef {
+            mesh: &m,
+            bvh: &bvh,
+        };
         let s = mesh_separation(
             r,
             &Pose::IDENTITY,
@@ -356,8 +373,16 @@ mod tests {
     #[test]
     fn overlapping_boxes_report_penetration() {
         let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-        let r = MeshRef { mesh: &m, bvh: &bvh };
-        let s = mesh_separation(r, &Pose::IDENTITY, r, &Pose::from_translation(Vec3::new(0.8, 0.0, 0.0)));
+        let r = MeshRef {
+            mesh: &m,
+            bvh: &bvh,
+        };
+        let s = mesh_separation(
+            r,
+            &Pose::IDENTITY,
+            r,
+            &Pose::from_translation(Vec3::new(0.8, 0.0, 0.0)),
+        );
         assert_eq!(s.distance, 0.0);
         assert!((s.penetration - 0.2).abs() < 1e-5, "{s:?}");
         assert!(s.signed_gap() < 0.0);
@@ -368,9 +393,15 @@ mod tests {
         let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
         let (small, small_bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
         let s = mesh_separation(
-            MeshRef { mesh: &big, bvh: &big_bvh },
+            MeshRef {
+                mesh: &big,
+                bvh: &big_bvh,
+            },
             &Pose::IDENTITY,
-            MeshRef { mesh: &small, bvh: &small_bvh },
+            MeshRef {
+                mesh: &small,
+                bvh: &small_bvh,
+            },
             &Pose::new(Quat::from_rotation_y(0.3), Vec3::ZERO),
         );
         assert!(s.overlapping());
@@ -380,7 +411,10 @@ mod tests {
     #[test]
     fn inside_test_on_a_rotated_box() {
         let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-        let r = MeshRef { mesh: &m, bvh: &bvh };
+        let r = MeshRef {
+            mesh: &m,
+            bvh: &bvh,
+        };
         assert!(point_inside_mesh(r, Vec3::splat(0.5)));
         assert!(point_inside_mesh(r, Vec3::new(0.5, 0.5, 0.999)));
         assert!(!point_inside_mesh(r, Vec3::new(0.5, 0.5, 1.001)));

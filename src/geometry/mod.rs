@@ -16,10 +16,10 @@ pub mod trimesh;
 pub use aabb::Aabb;
 pub use bvh::TriangleBvh;
 pub use closest::{
-    closest_point_triangle, closest_points_segment_segment, closest_points_triangle_triangle,
-    triangles_intersect, TrianglePair,
+    TrianglePair, closest_point_triangle, closest_points_segment_segment,
+    closest_points_triangle_triangle, triangles_intersect,
 };
 pub use mass::MassProperties;
-pub use mesh_distance::{mesh_separation, MeshRef, MeshSeparation};
+pub use mesh_distance::{MeshRef, MeshSeparation, mesh_separation};
 pub use pose::Pose;
 pub use trimesh::{MeshError, TriMesh};

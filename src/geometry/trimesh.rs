@@ -195,7 +195,8 @@ impl TriMesh {
 
     /// Every undirected edge must be used once in each direction.
     fn check_edges(&self) -> Result<(), MeshError> {
-        let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(self.triangles.len() * 3);
+        let mut directed: HashMap<(u32, u32), u32> =
+            HashMap::with_capacity(self.triangles.len() * 3);
         for t in &self.triangles {
             for k in 0..3 {
                 let e = (t[k], t[(k + 1) % 3]);
@@ -266,7 +267,10 @@ impl TriMesh {
             }
             if steps != degree[v] {
                 return Err(MeshError::NonManifold {
-                    what: format!("vertex {v} (it joins {} separate fans)", degree[v].div_ceil(steps.max(1))),
+                    what: format!(
+                        "vertex {v} (it joins {} separate fans)",
+                        degree[v].div_ceil(steps.max(1))
+                    ),
                 });
             }
         }
@@ -366,7 +370,10 @@ pub(crate) mod tests {
 
     #[test]
     fn empty_meshes_are_refused() {
-        assert!(matches!(TriMesh::default().validate(), Err(MeshError::Empty { .. })));
+        assert!(matches!(
+            TriMesh::default().validate(),
+            Err(MeshError::Empty { .. })
+        ));
     }
 
     #[test]
@@ -382,21 +389,37 @@ pub(crate) mod tests {
     fn bad_indices_are_refused() {
         let mut m = cuboid(Vec3::ZERO, Vec3::ONE);
         m.triangles[5][1] = 99;
-        assert!(matches!(m.validate(), Err(MeshError::IndexOutOfRange { triangle: 5, index: 99, .. })));
+        assert!(matches!(
+            m.validate(),
+            Err(MeshError::IndexOutOfRange {
+                triangle: 5,
+                index: 99,
+                ..
+            })
+        ));
     }
 
     #[test]
     fn holes_are_refused() {
         let mut m = cuboid(Vec3::ZERO, Vec3::ONE);
         m.triangles.pop();
-        assert!(matches!(m.validate(), Err(MeshError::Open { boundary_edges: 3, .. })));
+        assert!(matches!(
+            m.validate(),
+            Err(MeshError::Open {
+                boundary_edges: 3,
+                ..
+            })
+        ));
     }
 
     #[test]
     fn flipped_triangles_are_refused() {
         let mut m = cuboid(Vec3::ZERO, Vec3::ONE);
         m.triangles[0].swap(1, 2);
-        assert!(matches!(m.validate(), Err(MeshError::InconsistentWinding { .. })));
+        assert!(matches!(
+            m.validate(),
+            Err(MeshError::InconsistentWinding { .. })
+        ));
     }
 
     #[test]
@@ -412,7 +435,10 @@ pub(crate) mod tests {
     fn degenerate_triangles_are_refused() {
         let mut m = cuboid(Vec3::ZERO, Vec3::ONE);
         m.triangles[0][1] = m.triangles[0][0];
-        assert!(matches!(m.validate(), Err(MeshError::Degenerate { triangle: 0, .. })));
+        assert!(matches!(
+            m.validate(),
+            Err(MeshError::Degenerate { triangle: 0, .. })
+        ));
     }
 
     #[test]
@@ -430,7 +456,11 @@ pub(crate) mod tests {
                 _ => i + offset,
             }));
         }
-        assert!(matches!(m.validate(), Err(MeshError::NonManifold { .. })), "{:?}", m.validate());
+        assert!(
+            matches!(m.validate(), Err(MeshError::NonManifold { .. })),
+            "{:?}",
+            m.validate()
+        );
     }
 
     #[test]
@@ -442,9 +472,14 @@ pub(crate) mod tests {
         let mut m = a.clone();
         m.vertices.extend(b.vertices.iter().copied());
         for t in &b.triangles {
-            m.triangles.push(t.map(|i| if i == 0 { 7 } else { i + offset }));
+            m.triangles
+                .push(t.map(|i| if i == 0 { 7 } else { i + offset }));
         }
-        assert!(matches!(m.validate(), Err(MeshError::NonManifold { .. })), "{:?}", m.validate());
+        assert!(
+            matches!(m.validate(), Err(MeshError::NonManifold { .. })),
+            "{:?}",
+            m.validate()
+        );
     }
 
     #[test]
@@ -454,8 +489,12 @@ pub(crate) mod tests {
         let offset = a.vertices.len() as u32;
         let mut m = a.clone();
         m.vertices.extend(b.vertices.iter().copied());
-        m.triangles.extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|i| i + offset)));
         assert!(m.validate().is_ok());
-        assert!(matches!(m.validate_solid(), Err(MeshError::SelfIntersecting { .. })));
+        assert!(matches!(
+            m.validate_solid(),
+            Err(MeshError::SelfIntersecting { .. })
+        ));
     }
 }

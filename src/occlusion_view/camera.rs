@@ -25,9 +25,10 @@ impl Default for OrbitCamera {
 }
 
 /// The standard clinical views.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum CameraPreset {
     /// From the front, teeth in occlusion.
+    #[default]
     Frontal,
     /// From the patient's right.
     Right,
@@ -51,7 +52,7 @@ impl CameraPreset {
         };
         OrbitCamera {
             focus: Vec3::new(0.0, 0.0, 0.0),
-            distance: 120.0,
+            distance: 95.0,
             yaw,
             pitch,
         }
@@ -66,13 +67,21 @@ impl CameraPreset {
         );
         let eye = orbit.focus + dir * orbit.distance;
         // Near-vertical views keep the anterior teeth at the top of the screen.
-        let up = if orbit.pitch.abs() > 1.2 { -Vec3::Z * orbit.pitch.signum() } else { Vec3::Y };
+        let up = if orbit.pitch.abs() > 1.2 {
+            -Vec3::Z * orbit.pitch.signum()
+        } else {
+            Vec3::Y
+        };
         Transform::from_translation(eye).looking_at(orbit.focus, up)
     }
 }
 
-pub(super) fn spawn_camera_and_lights(mut commands: Commands) {
-    let orbit = OrbitCamera::default();
+/// The view the camera starts in.
+#[derive(Resource, Clone, Copy, Debug)]
+pub(super) struct InitialView(pub CameraPreset);
+
+pub(super) fn spawn_camera_and_lights(mut commands: Commands, initial: Res<InitialView>) {
+    let orbit = initial.0.orbit();
     commands.spawn((
         Name::new("orbit camera"),
         Camera3d::default(),
@@ -99,7 +108,10 @@ pub(super) fn spawn_camera_and_lights(mut commands: Commands) {
     ));
 }
 
-pub(super) fn camera_presets(keys: Res<ButtonInput<KeyCode>>, mut cameras: Query<&mut OrbitCamera>) {
+pub(super) fn camera_presets(
+    keys: Res<ButtonInput<KeyCode>>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
     let preset = [
         (KeyCode::Digit1, CameraPreset::Frontal),
         (KeyCode::Digit2, CameraPreset::Right),
@@ -125,7 +137,8 @@ pub(super) fn orbit_camera(
 ) {
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
     let pan = buttons.pressed(MouseButton::Middle) || (shift && buttons.pressed(MouseButton::Left));
-    let rotate = !pan && (buttons.pressed(MouseButton::Left) || buttons.pressed(MouseButton::Right));
+    let rotate =
+        !pan && (buttons.pressed(MouseButton::Left) || buttons.pressed(MouseButton::Right));
     let zoom = match scroll.unit {
         MouseScrollUnit::Line => scroll.delta.y,
         MouseScrollUnit::Pixel => scroll.delta.y / 40.0,

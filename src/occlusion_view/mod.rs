@@ -13,11 +13,16 @@ pub use camera::{CameraPreset, OrbitCamera};
 ///
 /// Mouse: left or right drag orbits, middle drag (or shift + left drag) pans, the wheel zooms.
 /// Keys: 1 frontal, 2 right, 3 left, 4 maxillary occlusal, 5 mandibular occlusal.
-pub struct OcclusionViewPlugin;
+#[derive(Default)]
+pub struct OcclusionViewPlugin {
+    /// The camera view at start-up.
+    pub initial_view: CameraPreset,
+}
 
 impl Plugin for OcclusionViewPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<tooth_render::ToothRenderAssets>()
+            .insert_resource(camera::InitialView(self.initial_view))
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.17)))
             .insert_resource(GlobalAmbientLight {
                 color: Color::WHITE,

@@ -23,10 +23,13 @@ fn render_mesh(shape: &ToothShape) -> Mesh {
     let positions: Vec<[f32; 3]> = m.vertices.iter().map(|v| v.to_array()).collect();
     let normals: Vec<[f32; 3]> = m.vertex_normals().iter().map(|n| n.to_array()).collect();
     let indices: Vec<u32> = m.triangles.iter().flatten().copied().collect();
-    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
-        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
-        .with_inserted_indices(Indices::U32(indices))
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
+    .with_inserted_indices(Indices::U32(indices))
 }
 
 pub(super) fn attach_tooth_meshes(
@@ -59,11 +62,15 @@ pub(super) fn attach_tooth_meshes(
                 })
             })
             .clone();
-        commands.entity(entity).insert((Mesh3d(mesh), MeshMaterial3d(material)));
+        commands
+            .entity(entity)
+            .insert((Mesh3d(mesh), MeshMaterial3d(material)));
     }
 }
 
-pub(super) fn hide_extracted(mut teeth: Query<&mut Visibility, (With<Tooth>, With<Extracted>, Changed<Visibility>)>) {
+pub(super) fn hide_extracted(
+    mut teeth: Query<&mut Visibility, (With<Tooth>, With<Extracted>, Changed<Visibility>)>,
+) {
     for mut v in &mut teeth {
         if *v != Visibility::Hidden {
             *v = Visibility::Hidden;

@@ -101,7 +101,10 @@ mod tests {
     #[test]
     fn bolton_ratios_of_the_table_are_near_the_norms() {
         let sum = |arch, n: usize| -> f32 {
-            ToothKind::ALL[..n].iter().map(|&k| 2.0 * anatomy(arch, k).mesiodistal).sum()
+            ToothKind::ALL[..n]
+                .iter()
+                .map(|&k| 2.0 * anatomy(arch, k).mesiodistal)
+                .sum()
         };
         let anterior = sum(Arch::Lower, 3) / sum(Arch::Upper, 3) * 100.0;
         let overall = sum(Arch::Lower, 6) / sum(Arch::Upper, 6) * 100.0;

@@ -31,7 +31,7 @@ use super::{
     fdi::{Arch, Fdi, Side, ToothKind},
     tooth_shape::{ShapeSet, ToothGeometry},
 };
-use crate::geometry::{mesh_separation, Aabb, Pose};
+use crate::geometry::{Aabb, Pose, mesh_separation};
 
 /// The beta-function arch form.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -85,7 +85,10 @@ impl ArchCurve {
         let (p, dir) = if u >= end_s {
             (end_p + Vec2::new(0.0, -(u - end_s)), Vec2::new(0.0, -1.0))
         } else {
-            let i = self.table.partition_point(|e| e.0 < u).clamp(1, self.table.len() - 1);
+            let i = self
+                .table
+                .partition_point(|e| e.0 < u)
+                .clamp(1, self.table.len() - 1);
             let (s0, p0) = self.table[i - 1];
             let (s1, p1) = self.table[i];
             let f = if s1 > s0 { (u - s0) / (s1 - s0) } else { 0.0 };
@@ -174,13 +177,17 @@ impl Arrangement {
     /// The default-layout arrangement for a resolution and spaces, computed once per process.
     pub fn shared(shapes: &ShapeSet, spaces: &Spaces) -> Arc<Arrangement> {
         type Key = (u32, Vec<(Fdi, u32)>);
-        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<OnceLock<Arc<Arrangement>>>>>> = OnceLock::new();
+        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<OnceLock<Arc<Arrangement>>>>>> =
+            OnceLock::new();
         let key = (
             shapes.resolution.vertices,
             spaces.iter().map(|(f, s)| (*f, s.to_bits())).collect(),
         );
         let cell = {
-            let mut map = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+            let mut map = CACHE
+                .get_or_init(Default::default)
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
             map.entry(key).or_default().clone()
         };
         cell.get_or_init(|| Arc::new(arrange(shapes, &ArchLayout::default(), spaces)))
@@ -204,7 +211,14 @@ fn arch_row(arch: Arch) -> usize {
 }
 
 /// Pose of a tooth whose cervical centre is at arc length `s` of `curve`.
-fn pose_on_curve(curve: &ArchCurve, s: f32, fdi: Fdi, shape: &ToothGeometry, layout: &ArchLayout, lift: f32) -> Pose {
+fn pose_on_curve(
+    curve: &ArchCurve,
+    s: f32,
+    fdi: Fdi,
+    shape: &ToothGeometry,
+    layout: &ArchLayout,
+    lift: f32,
+) -> Pose {
     let (p, t) = curve.at(s);
     let out = Vec3::new(-t.y, 0.0, t.x);
     let row = arch_row(fdi.arch());
@@ -280,7 +294,14 @@ fn place_arch(
     let space = |f: Fdi| spaces.get(&f).copied().unwrap_or(0.0);
     let midline_space = space(fdi(Side::Right, 1)) + space(fdi(Side::Left, 1));
     let u1 = solve_increasing(
-        |u| gap(&central, &pose(Side::Right, 1, u), &central, &pose(Side::Left, 1, u)),
+        |u| {
+            gap(
+                &central,
+                &pose(Side::Right, 1, u),
+                &central,
+                &pose(Side::Left, 1, u),
+            )
+        },
         half - 1.0,
         half + 1.0 + midline_space,
         layout.contact_gap + midline_space,
@@ -313,7 +334,10 @@ fn place_arch(
 fn molar_measures(shapes: &ShapeSet, upper: &[(Fdi, Pose)], lower: &[(Fdi, Pose)]) -> Vec2 {
     let centre = |teeth: &[(Fdi, Pose)], n: i64| {
         let f = Fdi::new(n).expect("valid FDI");
-        let pose = teeth.iter().find(|t| t.0 == f).map_or(Pose::IDENTITY, |t| t.1);
+        let pose = teeth
+            .iter()
+            .find(|t| t.0 == f)
+            .map_or(Pose::IDENTITY, |t| t.1);
         pose.transform_point(shapes.get(f.arch(), f.kind()).frame.crown_centre)
     };
     let overlap = [(16, 46), (26, 36)]
@@ -369,7 +393,11 @@ fn solve_upper_form(
         .fold(0.0, f32::max);
     let (lower_p, _) = lower_curve.at(s_lower);
     let model = |w: f32, d: f32, correction: Vec2| -> Vec2 {
-        let c = ArchCurve::new(&BetaArch { width: w, depth: d, front_z });
+        let c = ArchCurve::new(&BetaArch {
+            width: w,
+            depth: d,
+            front_z,
+        });
         let (p, _) = c.at(s_upper);
         let (cusp, _) = c.at(s_upper - cusp_ahead);
         Vec2::new(p.x - lower_p.x - layout.buccal_overlap, cusp.y - lower_p.y) + correction
@@ -383,7 +411,11 @@ fn solve_upper_form(
         (width_for(d), d)
     };
     let place = |w: f32, d: f32| -> Vec<(Fdi, Pose)> {
-        let form = BetaArch { width: w, depth: d, front_z };
+        let form = BetaArch {
+            width: w,
+            depth: d,
+            front_z,
+        };
         place_arch(Arch::Upper, &ArchCurve::new(&form), shapes, layout, spaces)
             .into_iter()
             .map(|(f, p, _)| (f, p))
@@ -392,7 +424,8 @@ fn solve_upper_form(
     let mut correction = Vec2::ZERO;
     let (mut w, mut d) = solve_model(correction);
     let mut upper = place(w, d);
-    let mut residual = molar_measures(shapes, &upper, lower) - Vec2::new(layout.buccal_overlap, 0.0);
+    let mut residual =
+        molar_measures(shapes, &upper, lower) - Vec2::new(layout.buccal_overlap, 0.0);
     for _ in 0..2 {
         if residual.length() < 0.05 {
             break;
@@ -406,13 +439,26 @@ fn solve_upper_form(
         }
         (w, d, upper, residual) = (nw, nd, candidate, r);
     }
-    (BetaArch { width: w, depth: d, front_z }, residual, upper)
+    (
+        BetaArch {
+            width: w,
+            depth: d,
+            front_z,
+        },
+        residual,
+        upper,
+    )
 }
 
 /// Nominal arc position of a tooth's centre from the tooth widths alone.
 fn nominal_arc(shapes: &ShapeSet, arch: Arch, position: u8) -> f32 {
     let widths: Vec<f32> = (1..=position)
-        .map(|p| shapes.get(arch, ToothKind::from_position(p).expect("1-8")).anatomy.mesiodistal)
+        .map(|p| {
+            shapes
+                .get(arch, ToothKind::from_position(p).expect("1-8"))
+                .anatomy
+                .mesiodistal
+        })
         .collect();
     widths.iter().sum::<f32>() - 0.5 * widths[widths.len() - 1]
 }
@@ -422,10 +468,16 @@ pub type Spaces = BTreeMap<Fdi, f32>;
 
 /// Builds the arrangement of all 32 teeth, with extra spaces where asked.
 pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arrangement {
-    let lower: Vec<(Fdi, Pose)> = place_arch(Arch::Lower, &ArchCurve::new(&layout.lower), shapes, layout, spaces)
-        .into_iter()
-        .map(|(f, p, _)| (f, p))
-        .collect();
+    let lower: Vec<(Fdi, Pose)> = place_arch(
+        Arch::Lower,
+        &ArchCurve::new(&layout.lower),
+        shapes,
+        layout,
+        spaces,
+    )
+    .into_iter()
+    .map(|(f, p, _)| (f, p))
+    .collect();
     let (upper_form, upper_residual, upper) = solve_upper_form(shapes, layout, &lower, spaces);
     let shape_of = |f: Fdi| shapes.get(f.arch(), f.kind());
     // Opposing pairs whose footprints come near each other.
@@ -476,12 +528,20 @@ pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arran
 pub fn measure_occlusion(shapes: &ShapeSet, poses: &[(Fdi, Pose)]) -> OcclusionMeasures {
     let pose = |n: i64| {
         let f = Fdi::new(n).expect("valid FDI");
-        (shapes.get(f.arch(), f.kind()), poses.iter().find(|(g, _)| *g == f).map_or(Pose::IDENTITY, |x| x.1))
+        (
+            shapes.get(f.arch(), f.kind()),
+            poses
+                .iter()
+                .find(|(g, _)| *g == f)
+                .map_or(Pose::IDENTITY, |x| x.1),
+        )
     };
     let mut overjet = 0.0;
     let mut overbite = 0.0;
     let mut molar = 0.0;
-    for (upper_incisor, lower_incisor, upper_molar, lower_molar) in [(11, 41, 16, 46), (21, 31, 26, 36)] {
+    for (upper_incisor, lower_incisor, upper_molar, lower_molar) in
+        [(11, 41, 16, 46), (21, 31, 26, 36)]
+    {
         let (su, pu) = pose(upper_incisor);
         let (sl, pl) = pose(lower_incisor);
         let edge = pu.transform_point(su.cusp_tips[0]);
@@ -496,7 +556,11 @@ pub fn measure_occlusion(shapes: &ShapeSet, poses: &[(Fdi, Pose)]) -> OcclusionM
             .filter(|v| (v.y - edge.y).abs() < 1.0 && (v.x - edge.x).abs() < 2.0)
             .map(|v| v.z)
             .fold(f32::NEG_INFINITY, f32::max);
-        overjet += if labial.is_finite() { edge.z - labial } else { f32::NAN };
+        overjet += if labial.is_finite() {
+            edge.z - labial
+        } else {
+            f32::NAN
+        };
         let (su, pu) = pose(upper_molar);
         let (sl, pl) = pose(lower_molar);
         let mesiobuccal = su
@@ -535,7 +599,10 @@ mod tests {
         assert!((t - Vec2::X).length() < 1e-2, "{t}");
         let (l, tl) = curve.at(30.0);
         let (r, tr) = curve.at(-30.0);
-        assert!((l.x + r.x).abs() < 1e-4 && (l.y - r.y).abs() < 1e-4, "mirror symmetric");
+        assert!(
+            (l.x + r.x).abs() < 1e-4 && (l.y - r.y).abs() < 1e-4,
+            "mirror symmetric"
+        );
         assert!(tl.y < 0.0 && tr.y > 0.0);
         // Past the end the curve runs straight back.
         let (far, tf) = curve.at(200.0);

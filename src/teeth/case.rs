@@ -7,8 +7,8 @@
 use std::{collections::BTreeMap, fmt, path::Path};
 
 use serde::{
-    de::{self, MapAccess, SeqAccess, Visitor},
     Deserialize, Deserializer, Serialize,
+    de::{self, MapAccess, SeqAccess, Visitor},
 };
 use thiserror::Error;
 
@@ -51,7 +51,9 @@ pub enum CaseError {
         message: String,
     },
     /// The name is neither a built-in case nor an existing file.
-    #[error("unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file")]
+    #[error(
+        "unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file"
+    )]
     Unknown(String),
 }
 
@@ -79,7 +81,9 @@ impl<'de> Deserialize<'de> for NonNegative {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let Finite(v) = Finite::deserialize(d)?;
         if v < 0.0 {
-            return Err(de::Error::custom(format!("size must not be negative, got {v}")));
+            return Err(de::Error::custom(format!(
+                "size must not be negative, got {v}"
+            )));
         }
         Ok(Self(v))
     }
@@ -438,15 +442,23 @@ impl Case {
 
     /// The mesh resolution asked for.
     pub fn tooth_resolution(&self) -> ToothResolution {
-        self.resolution.map_or(ToothResolution::PAPER, |vertices| ToothResolution { vertices })
+        self.resolution
+            .map_or(ToothResolution::PAPER, |vertices| ToothResolution {
+                vertices,
+            })
     }
 
     /// The wire model of a tooth.
     pub fn wire_of(&self, f: Fdi) -> WireModel {
-        self.wire.teeth.0.get(&f).copied().unwrap_or(match f.arch() {
-            super::fdi::Arch::Upper => self.wire.upper,
-            super::fdi::Arch::Lower => self.wire.lower,
-        })
+        self.wire
+            .teeth
+            .0
+            .get(&f)
+            .copied()
+            .unwrap_or(match f.arch() {
+                super::fdi::Arch::Upper => self.wire.upper,
+                super::fdi::Arch::Lower => self.wire.lower,
+            })
     }
 
     /// Cross-field checks: (field, offending token, message).
@@ -454,21 +466,34 @@ impl Case {
         let present = self.present();
         if let Some(r) = self.resolution {
             if !(20..=200_000).contains(&r) {
-                return Err(("resolution", Some(r.to_string()), format!("resolution must be 20–200000 vertices, got {r}")));
+                return Err((
+                    "resolution",
+                    Some(r.to_string()),
+                    format!("resolution must be 20–200000 vertices, got {r}"),
+                ));
             }
         }
         for f in &self.extracted.0 {
             if !present.contains(f) {
-                return Err(("extracted", Some(f.to_string()), format!("tooth {f} is extracted but not present")));
+                return Err((
+                    "extracted",
+                    Some(f.to_string()),
+                    format!("tooth {f} is extracted but not present"),
+                ));
             }
         }
-        let absent = |field: &'static str, f: &Fdi| -> Result<(), (&'static str, Option<String>, String)> {
-            if !present.contains(f) {
-                Err((field, Some(f.to_string()), format!("tooth {f} is not present in this case")))
-            } else {
-                Ok(())
-            }
-        };
+        let absent =
+            |field: &'static str, f: &Fdi| -> Result<(), (&'static str, Option<String>, String)> {
+                if !present.contains(f) {
+                    Err((
+                        field,
+                        Some(f.to_string()),
+                        format!("tooth {f} is not present in this case"),
+                    ))
+                } else {
+                    Ok(())
+                }
+            };
         for f in self.spaces.0.keys() {
             absent("spaces", f)?;
         }
@@ -492,15 +517,27 @@ impl Case {
             for f in &load.teeth.0 {
                 absent("loads", f)?;
                 if self.is_extracted(*f) {
-                    return Err(("loads", Some(f.to_string()), format!("load on extracted tooth {f}")));
+                    return Err((
+                        "loads",
+                        Some(f.to_string()),
+                        format!("load on extracted tooth {f}"),
+                    ));
                 }
             }
             let (fm, tm) = (load.force.magnitude(), load.torque.magnitude());
             if fm > MAX_FORCE_N {
-                return Err(("force", None, format!("force of {fm:.1} N is beyond the {MAX_FORCE_N} N accepted")));
+                return Err((
+                    "force",
+                    None,
+                    format!("force of {fm:.1} N is beyond the {MAX_FORCE_N} N accepted"),
+                ));
             }
             if tm > MAX_TORQUE_NMM {
-                return Err(("torque", None, format!("torque of {tm:.1} N·mm is beyond the {MAX_TORQUE_NMM} N·mm accepted")));
+                return Err((
+                    "torque",
+                    None,
+                    format!("torque of {tm:.1} N·mm is beyond the {MAX_TORQUE_NMM} N·mm accepted"),
+                ));
             }
         }
         for c in &self.constraints {
@@ -539,7 +576,11 @@ fn locate(source: &str, field: &str, token: Option<&str>) -> (usize, usize) {
     };
     let Some(at) = at else { return (1, 1) };
     let line = source[..at].matches('\n').count() + 1;
-    let column = source[..at].rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    let column = source[..at]
+        .rsplit('\n')
+        .next()
+        .map_or(0, |l| l.chars().count())
+        + 1;
     (line, column)
 }
 
@@ -578,10 +619,14 @@ mod tests {
         let (l, _, m) = err("Case(\n  name: \"x\",\n  colour: 3,\n)");
         assert_eq!(l, 3);
         assert!(m.contains("colour"), "{m}");
-        let (l, c, m) = err("Case(\n  name: \"x\",\n  extracted: [14],\n  loads: [(teeth: [16, 14], force: World(0.0, 0.0, 1.0))],\n)");
+        let (l, c, m) = err(
+            "Case(\n  name: \"x\",\n  extracted: [14],\n  loads: [(teeth: [16, 14], force: World(0.0, 0.0, 1.0))],\n)",
+        );
         assert_eq!((l, c), (4, 24), "{m}");
         assert!(m.contains("extracted tooth 14"), "{m}");
-        let (l, _, m) = err("Case(\n  name: \"x\",\n  loads: [(teeth: [16],\n    force: World(0.0, NaN, 1.0))],\n)");
+        let (l, _, m) = err(
+            "Case(\n  name: \"x\",\n  loads: [(teeth: [16],\n    force: World(0.0, NaN, 1.0))],\n)",
+        );
         assert_eq!(l, 4);
         assert!(m.contains("finite"), "{m}");
         let (l, _, m) = err("Case(\n  name: \"x\",\n  spaces: {21: -2.0},\n)");
@@ -590,7 +635,8 @@ mod tests {
         let (l, _, m) = err("Case(\n  name: \"x\",\n  offsets: {11: (), 11: ()},\n)");
         assert_eq!(l, 3);
         assert!(m.contains("duplicate"), "{m}");
-        let (_, _, m) = err("Case(name: \"x\", loads: [(teeth: [16], force: World(0.0, 0.0, 1e9))])");
+        let (_, _, m) =
+            err("Case(name: \"x\", loads: [(teeth: [16], force: World(0.0, 0.0, 1e9))])");
         assert!(m.contains("beyond"), "{m}");
         let (l, c, m) = err("");
         assert_eq!((l, c), (1, 1));
@@ -602,6 +648,9 @@ mod tests {
     #[test]
     fn unknown_names_are_refused() {
         assert!(matches!(Case::resolve("nope"), Err(CaseError::Unknown(_))));
-        assert!(matches!(Case::resolve("/no/such/file.ron"), Err(CaseError::Io { .. })));
+        assert!(matches!(
+            Case::resolve("/no/such/file.ron"),
+            Err(CaseError::Io { .. })
+        ));
     }
 }

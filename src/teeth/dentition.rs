@@ -115,14 +115,14 @@ impl Dentition {
             if let Some(offset) = case.offsets.0.get(&tooth.fdi) {
                 let [m, b, o] = tooth.anatomical_axes();
                 let (t, r) = (offset.translation, offset.rotation_deg);
-                let rotation = Quat::from_axis_angle(m, r.0 .0.to_radians())
-                    * Quat::from_axis_angle(b, r.1 .0.to_radians())
-                    * Quat::from_axis_angle(o, r.2 .0.to_radians());
+                let rotation = Quat::from_axis_angle(m, r.0.0.to_radians())
+                    * Quat::from_axis_angle(b, r.1.0.to_radians())
+                    * Quat::from_axis_angle(o, r.2.0.to_radians());
                 let pivot = tooth.crown_centre();
                 let about_pivot = Pose::from_translation(pivot)
                     .mul(&Pose::new(rotation, Vec3::ZERO))
                     .mul(&Pose::from_translation(-pivot));
-                let shift = Pose::from_translation(m * t.0 .0 + b * t.1 .0 + o * t.2 .0);
+                let shift = Pose::from_translation(m * t.0.0 + b * t.1.0 + o * t.2.0);
                 tooth.pose = shift.mul(&about_pivot).mul(&tooth.pose);
             }
         }
@@ -171,7 +171,8 @@ impl Dentition {
     pub fn neighbour_pairs(&self) -> Vec<(Fdi, Fdi)> {
         let mut pairs = Vec::new();
         for arch in [Arch::Upper, Arch::Lower] {
-            let mut row: Vec<&PlacedTooth> = self.visible().filter(|t| t.fdi.arch() == arch).collect();
+            let mut row: Vec<&PlacedTooth> =
+                self.visible().filter(|t| t.fdi.arch() == arch).collect();
             row.sort_by_key(|t| t.fdi.arch_index());
             pairs.extend(row.windows(2).map(|w| (w[0].fdi, w[1].fdi)));
         }

@@ -89,7 +89,9 @@ impl ToothFrame {
             .vertices
             .iter()
             .map(|&v| level(v))
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), l| (lo.min(l), hi.max(l)));
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), l| {
+                (lo.min(l), hi.max(l))
+            });
         let com = mp.centre_of_mass;
         let on_axis = |l: f32| com + long_axis * (l - level(com));
         let root_length = (-lowest).max(0.0);

@@ -19,6 +19,8 @@ pub use case::{Case, CaseError, LoadedCase, WireModel};
 pub use components::{Extracted, Load, LoadGroup, Tooth, ToothShape, Wire};
 pub use dentition::{Dentition, PlacedTooth};
 pub use fdi::{Arch, Fdi, Side, ToothKind};
-pub use plugin::{ActiveCase, CaseLoadFailed, CaseLoaded, LoadCase, TeethModelPlugin, TeethModelSystems};
+pub use plugin::{
+    ActiveCase, CaseLoadFailed, CaseLoaded, LoadCase, TeethModelPlugin, TeethModelSystems,
+};
 pub use shape::ToothResolution;
 pub use tooth_shape::{ShapeSet, ToothGeometry};

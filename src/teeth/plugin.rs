@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use bevy::{
     prelude::*,
-    tasks::{block_on, futures_lite::future, AsyncComputeTaskPool, Task},
+    tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future},
 };
 
 use super::{
@@ -65,7 +65,10 @@ impl Plugin for TeethModelPlugin {
         app.add_message::<LoadCase>()
             .add_message::<CaseLoaded>()
             .add_message::<CaseLoadFailed>()
-            .configure_sets(Update, (TeethModelSystems::Request, TeethModelSystems::Spawn).chain())
+            .configure_sets(
+                Update,
+                (TeethModelSystems::Request, TeethModelSystems::Spawn).chain(),
+            )
             .add_systems(
                 Update,
                 (
@@ -86,7 +89,8 @@ fn start_loading(mut commands: Commands, mut requests: MessageReader<LoadCase>) 
     let Some(LoadCase(name)) = requests.read().last().cloned() else {
         return;
     };
-    let task = AsyncComputeTaskPool::get().spawn(async move { Case::resolve(&name).and_then(Dentition::build) });
+    let task = AsyncComputeTaskPool::get()
+        .spawn(async move { Case::resolve(&name).and_then(Dentition::build) });
     commands.insert_resource(PendingCase(task));
 }
 
@@ -143,6 +147,10 @@ fn finish_loading(
         name: dentition.case.case.name.clone(),
         teeth: dentition.teeth.len(),
     });
-    info!("loaded case '{}' ({} teeth)", dentition.case.case.name, dentition.teeth.len());
+    info!(
+        "loaded case '{}' ({} teeth)",
+        dentition.case.case.name,
+        dentition.teeth.len()
+    );
     commands.insert_resource(ActiveCase(Arc::new(dentition)));
 }

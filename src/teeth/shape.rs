@@ -23,8 +23,8 @@ use super::{
     fdi::{Arch, ToothKind},
 };
 use crate::geometry::{
-    decimate::{decimate, DecimateOptions},
     TriMesh,
+    decimate::{DecimateOptions, decimate},
 };
 
 /// How finely a tooth is meshed.
@@ -50,7 +50,11 @@ impl ToothResolution {
     fn grid(self) -> (usize, bool) {
         const SIMPLIFY_FROM: usize = 26;
         let n = ((self.vertices.max(8) as f64 - 2.0) / 6.0).sqrt().ceil() as usize;
-        if n >= SIMPLIFY_FROM { (n, false) } else { (SIMPLIFY_FROM, true) }
+        if n >= SIMPLIFY_FROM {
+            (n, false)
+        } else {
+            (SIMPLIFY_FROM, true)
+        }
     }
 }
 
@@ -214,7 +218,12 @@ impl ToothSolid {
             }
             kind => {
                 let cusps: &[(f32, f32, f32)] = if kind.is_molar() {
-                    &[(0.5, 0.5, 1.0), (-0.5, 0.5, 1.0), (0.5, -0.5, 0.95), (-0.5, -0.5, 0.9)]
+                    &[
+                        (0.5, 0.5, 1.0),
+                        (-0.5, 0.5, 1.0),
+                        (0.5, -0.5, 0.95),
+                        (-0.5, -0.5, 0.9),
+                    ]
                 } else {
                     &[(0.0, 0.5, 1.0), (0.0, -0.5, 0.85)]
                 };
@@ -237,7 +246,9 @@ impl ToothSolid {
         } else {
             -self.trunk
         };
-        let hw = self.half_widths(p.y.clamp(bottom, an.crown_length)).max(Vec2::splat(0.02));
+        let hw = self
+            .half_widths(p.y.clamp(bottom, an.crown_length))
+            .max(Vec2::splat(0.02));
         let n = self.squareness;
         let ratio = ((p.x.abs() / hw.x).powf(n) + (p.z.abs() / hw.y).powf(n)).powf(1.0 / n);
         let lateral = (ratio - 1.0) * hw.min_element();
@@ -250,7 +261,8 @@ impl ToothSolid {
     fn root(&self, root: &Root, p: Vec3) -> f32 {
         let axis = root.apex - self.centre;
         let len2 = axis.length_squared();
-        let t = ((p - self.centre).dot(axis) / len2).clamp(0.0, 1.0);
+        let t_along = (p - self.centre).dot(axis) / len2;
+        let t = t_along.clamp(0.0, 1.0);
         let on_axis = self.centre + axis * t;
         let profile = (1.0 - t).powf(0.6).max(1e-3);
         let r = root.radius * profile;
@@ -259,7 +271,9 @@ impl ToothSolid {
         // The root starts at the plane through the star centre across its axis; above it the body
         // takes over.
         let below = -(p - self.centre).dot(axis) / len2.sqrt();
-        let cone = ((rho - 1.0) * r.min_element()).max(below);
+        // Past the apex the root ends (the tip sphere rounds it).
+        let beyond = (t_along - 1.0) * len2.sqrt();
+        let cone = ((rho - 1.0) * r.min_element()).max(below).max(beyond);
         let tip = (p - root.apex).length() - 0.35;
         cone.min(tip)
     }
@@ -286,7 +300,9 @@ impl ToothSolid {
             Vec3::new(x, self.occlusal_height(x, z), z)
         };
         match self.kind {
-            ToothKind::CentralIncisor | ToothKind::LateralIncisor | ToothKind::Canine => vec![at(0.0, 0.0)],
+            ToothKind::CentralIncisor | ToothKind::LateralIncisor | ToothKind::Canine => {
+                vec![at(0.0, 0.0)]
+            }
             k if k.is_molar() => vec![at(0.5, 0.5), at(-0.5, 0.5), at(0.5, -0.5), at(-0.5, -0.5)],
             _ => vec![at(0.0, 0.5), at(0.0, -0.5)],
         }
@@ -372,7 +388,9 @@ pub fn cube_sphere(n: usize) -> TriMesh {
             let p = normal * n_i as f32 + u * (2 * i - n_i) as f32 + v * (2 * j - n_i) as f32;
             let key = [p.x.round() as i32, p.y.round() as i32, p.z.round() as i32];
             *index.entry(key).or_insert_with(|| {
-                let a = |k: i32| (std::f32::consts::FRAC_PI_4 * (2 * k - n_i) as f32 / n_i as f32).tan();
+                let a = |k: i32| {
+                    (std::f32::consts::FRAC_PI_4 * (2 * k - n_i) as f32 / n_i as f32).tan()
+                };
                 let d = (normal + u * a(i) + v * a(j)).normalize();
                 vertices.push(d);
                 (vertices.len() - 1) as u32
@@ -411,7 +429,11 @@ mod tests {
                 let r = mesh
                     .validate_solid()
                     .unwrap_or_else(|e| panic!("{arch:?} {kind:?}: {e}"));
-                assert!((100..=160).contains(&r.vertices), "{arch:?} {kind:?}: {} vertices", r.vertices);
+                assert!(
+                    (100..=160).contains(&r.vertices),
+                    "{arch:?} {kind:?}: {} vertices",
+                    r.vertices
+                );
             }
         }
     }

@@ -9,7 +9,7 @@ use std::{
 use glam::Vec3;
 
 use super::{
-    anatomy::{anatomy, ToothAnatomy},
+    anatomy::{ToothAnatomy, anatomy},
     fdi::{Arch, ToothKind},
     frame::{CentreParameters, ToothFrame},
     shape::{ToothResolution, ToothSolid},
@@ -41,7 +41,13 @@ impl ToothGeometry {
         let an = anatomy(arch, kind);
         let solid = ToothSolid::new(arch, kind, an);
         let mesh = solid.mesh(resolution);
-        let frame = ToothFrame::from_mesh(&mesh, Vec3::ZERO, Vec3::Y, Vec3::Z, CentreParameters::default());
+        let frame = ToothFrame::from_mesh(
+            &mesh,
+            Vec3::ZERO,
+            Vec3::Y,
+            Vec3::Z,
+            CentreParameters::default(),
+        );
         let bvh = TriangleBvh::build(&mesh);
         Self {
             arch,
@@ -87,7 +93,9 @@ impl ShapeSet {
             .into_iter()
             .flat_map(|a| ToothKind::ALL.into_iter().map(move |k| (a, k)))
             .collect();
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(jobs.len());
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(jobs.len());
         let mut slots: Vec<Option<Arc<ToothGeometry>>> = vec![None; jobs.len()];
         std::thread::scope(|scope| {
             let chunks: Vec<_> = slots
@@ -110,11 +118,16 @@ impl ShapeSet {
 
     /// The shared set for a resolution, built once per process.
     pub fn shared(resolution: ToothResolution) -> Arc<ShapeSet> {
-        static CACHE: OnceLock<Mutex<HashMap<ToothResolution, Arc<OnceLock<Arc<ShapeSet>>>>>> = OnceLock::new();
+        static CACHE: OnceLock<Mutex<HashMap<ToothResolution, Arc<OnceLock<Arc<ShapeSet>>>>>> =
+            OnceLock::new();
         let cell = {
-            let mut map = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+            let mut map = CACHE
+                .get_or_init(Default::default)
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
             map.entry(resolution).or_default().clone()
         };
-        cell.get_or_init(|| Arc::new(Self::build(resolution))).clone()
+        cell.get_or_init(|| Arc::new(Self::build(resolution)))
+            .clone()
     }
 }

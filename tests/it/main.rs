@@ -1,2 +1,6 @@
-#[test]
-fn placeholder() {}
+//! orthosim integration tests: one test binary (one link of Bevy), one module per topic.
+
+mod cli;
+mod ecs;
+mod oracle;
+mod teeth;

@@ -1,0 +1,131 @@
+//! The `orthosim` binary's headless subcommands, as a user runs them.
+
+use std::process::Command;
+
+fn orthosim(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_orthosim"))
+        .args(args)
+        .output()
+        .expect("the orthosim binary runs")
+}
+
+#[test]
+fn cases_lists_the_four_builtin_cases() {
+    let out = orthosim(&["cases"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let names: Vec<&str> = text
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap_or(""))
+        .collect();
+    assert_eq!(names, ["normal", "case1", "case2", "case3"], "{text}");
+}
+
+#[test]
+fn inspect_normal_meets_the_arrangement_figures() {
+    let out = orthosim(&["inspect", "--case", "normal", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["case"], "normal");
+    let teeth = v["teeth"].as_array().unwrap();
+    assert_eq!(teeth.len(), 32);
+    for t in teeth {
+        for key in [
+            "fdi",
+            "kind",
+            "arch",
+            "vertices",
+            "triangles",
+            "closed",
+            "volume_mm3",
+            "crown_centre",
+            "extracted",
+        ] {
+            assert!(t.get(key).is_some(), "missing {key} in {t}");
+        }
+        assert_eq!(t["closed"], true, "{t}");
+        assert!(t["volume_mm3"].as_f64().unwrap() > 0.0);
+        let n = t["vertices"].as_u64().unwrap();
+        assert!((100..=250).contains(&n), "{n} vertices: {t}");
+        assert_eq!(t["crown_centre"].as_array().unwrap().len(), 3);
+    }
+    let gaps = v["neighbour_gaps_mm"].as_array().unwrap();
+    assert_eq!(gaps.len(), 30, "15 contacts per arch");
+    for g in gaps {
+        let gap = g["gap_mm"].as_f64().unwrap();
+        assert!((0.0..=0.1).contains(&gap), "{g}");
+    }
+    assert!(v["max_penetration_mm"].as_f64().unwrap() <= 0.01);
+    assert!(v["occlusal_max_penetration_mm"].as_f64().unwrap() <= 0.05);
+}
+
+#[test]
+fn inspect_skips_extracted_teeth_in_the_gaps() {
+    let out = orthosim(&["inspect", "--case", "case1", "--json"]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let gaps = v["neighbour_gaps_mm"].as_array().unwrap();
+    assert_eq!(gaps.len(), 26, "14 visible teeth per arch");
+    let across = gaps
+        .iter()
+        .find(|g| g["a"] == 15 && g["b"] == 13)
+        .expect("15-13 pair across the space");
+    assert!(across["gap_mm"].as_f64().unwrap() > 5.0, "{across}");
+    assert!(gaps.iter().all(|g| g["a"] != 14 && g["b"] != 14));
+}
+
+#[test]
+fn bad_case_files_fail_with_one_line_and_a_position() {
+    let dir = std::env::temp_dir().join(format!("orthosim-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = [
+        (
+            "syntax.ron",
+            "Case(\n  name: \"x\"\n  extracted: [14],\n)\n",
+            ":3:",
+        ),
+        (
+            "unknown.ron",
+            "Case(\n  name: \"x\",\n  extracted: [14, 59],\n)\n",
+            ":3:",
+        ),
+        (
+            "nan.ron",
+            "Case(\n  name: \"x\",\n  loads: [(teeth: [16], force: World(inf, 0.0, 0.0))],\n)\n",
+            ":3:",
+        ),
+        (
+            "extracted.ron",
+            "Case(\n  name: \"x\",\n  extracted: [16],\n  loads: [(teeth: [16], force: World(1.0, 0.0, 0.0))],\n)\n",
+            ":4:",
+        ),
+        ("empty.ron", "", ":1:1:"),
+    ];
+    for (name, text, position) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = orthosim(&["inspect", "--case", path.to_str().unwrap()]);
+        assert!(!out.status.success(), "{name} accepted");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(&format!("{name}{position}")), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let out = orthosim(&["inspect", "--case", "no-such-case"]);
+    assert!(!out.status.success());
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn help_lists_the_subcommands() {
+    let out = orthosim(&["--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for sub in ["view", "cases", "inspect"] {
+        assert!(text.contains(sub), "{text}");
+    }
+}

@@ -1,0 +1,164 @@
+//! The ECS layer, headless: loading cases spawns the right tooth entities.
+
+use std::{sync::Arc, time::Duration};
+
+use bevy::{prelude::*, time::TimeUpdateStrategy};
+use orthosim::{
+    prelude::*,
+    teeth::{CaseLoadFailed, Wire, WireModel},
+};
+
+/// A headless app with the simulation plugins and a manual clock.
+fn create_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, TransformPlugin, OrthoSimPlugins))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+            16,
+        )));
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Sends a load request and updates until the case is in the world (or fails).
+fn load(app: &mut App, case: &str) -> Result<(), String> {
+    app.world_mut().write_message(LoadCase(case.to_owned()));
+    for _ in 0..2000 {
+        app.update();
+        let loaded = app
+            .world()
+            .resource::<Messages<CaseLoaded>>()
+            .iter_current_update_messages()
+            .count()
+            > 0;
+        if loaded {
+            return Ok(());
+        }
+        if let Some(e) = app
+            .world()
+            .resource::<Messages<CaseLoadFailed>>()
+            .iter_current_update_messages()
+            .next()
+        {
+            return Err(e.0.to_string());
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    Err("case did not load in time".into())
+}
+
+fn tooth_entities(app: &mut App) -> Vec<(Tooth, ToothShape, Load, Transform, bool, Wire)> {
+    let mut q = app.world_mut().query::<(
+        &Tooth,
+        &ToothShape,
+        &Load,
+        &Transform,
+        Has<Extracted>,
+        &Wire,
+    )>();
+    let mut v: Vec<_> = q
+        .iter(app.world())
+        .map(|(t, s, l, tr, e, w)| (*t, s.clone(), *l, *tr, e, *w))
+        .collect();
+    v.sort_by_key(|x| x.0.id);
+    v
+}
+
+#[test]
+fn every_builtin_case_spawns_its_teeth() {
+    let mut app = create_app();
+    for (case, extracted) in [
+        ("normal", vec![]),
+        ("case1", vec![14, 24, 34, 44]),
+        ("case2", vec![15, 25, 35, 45]),
+        ("case3", vec![]),
+    ] {
+        load(&mut app, case).unwrap();
+        let teeth = tooth_entities(&mut app);
+        assert_eq!(teeth.len(), 32, "{case}: one entity per present tooth");
+        let marked: Vec<u8> = teeth
+            .iter()
+            .filter(|t| t.4)
+            .map(|t| t.0.id.number())
+            .collect();
+        assert_eq!(marked, extracted, "{case}: Extracted markers");
+        for (tooth, shape, _, transform, _, wire) in &teeth {
+            assert_eq!(tooth.kind, tooth.id.kind());
+            assert_eq!(shape.kind, tooth.kind);
+            assert!(transform.translation.is_finite() && transform.rotation.is_normalized());
+            assert_eq!(wire.0, WireModel::Rectangular);
+        }
+        let active = app.world().resource::<ActiveCase>();
+        assert_eq!(active.case.case.name, case);
+    }
+}
+
+#[test]
+fn mirrored_teeth_share_one_shape() {
+    let mut app = create_app();
+    load(&mut app, "normal").unwrap();
+    let teeth = tooth_entities(&mut app);
+    let shape = |n: u8| {
+        teeth
+            .iter()
+            .find(|t| t.0.id.number() == n)
+            .unwrap()
+            .1
+            .0
+            .clone()
+    };
+    assert!(Arc::ptr_eq(&shape(11), &shape(21)));
+    assert!(Arc::ptr_eq(&shape(36), &shape(46)));
+    assert!(
+        !Arc::ptr_eq(&shape(16), &shape(46)),
+        "upper and lower molars differ"
+    );
+    let distinct: std::collections::HashSet<usize> =
+        teeth.iter().map(|t| Arc::as_ptr(&t.1.0) as usize).collect();
+    assert_eq!(distinct.len(), 16);
+}
+
+#[test]
+fn case_loads_become_load_components() {
+    let mut app = create_app();
+    load(&mut app, "case1").unwrap();
+    let teeth = tooth_entities(&mut app);
+    for (tooth, shape, load, transform, _, _) in &teeth {
+        let n = tooth.id.number();
+        if [16, 26, 36, 46].contains(&n) {
+            assert!((load.force.length() - 1.5).abs() < 1e-4, "{n}: {load:?}");
+            // Mesial on a first molar points forwards (+z) and towards the midline.
+            let centre = transform.transform_point(shape.frame.crown_centre);
+            assert!(load.force.z > 1.0, "{n}: {load:?}");
+            assert!(
+                load.force.x * centre.x <= 0.0,
+                "{n} pushed away from the midline: {load:?}"
+            );
+        } else {
+            assert_eq!(load.force, Vec3::ZERO, "{n}");
+        }
+    }
+    load(&mut app, "case3").unwrap();
+    for (tooth, _, load, _, _, _) in tooth_entities(&mut app) {
+        match tooth.id.number() {
+            11 | 41 => assert_eq!(load.force, Vec3::X),
+            21 | 31 => assert_eq!(load.force, -Vec3::X),
+            _ => assert_eq!(load.force, Vec3::ZERO),
+        }
+    }
+}
+
+#[test]
+fn a_bad_case_leaves_the_scene_as_it_was() {
+    let mut app = create_app();
+    load(&mut app, "case2").unwrap();
+    let dir = std::env::temp_dir().join(format!("orthosim-ecs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.ron");
+    std::fs::write(&bad, "Case(\n  name: \"bad\",\n  extracted: [14, 99],\n)\n").unwrap();
+    let err = load(&mut app, bad.to_str().unwrap()).unwrap_err();
+    assert!(err.contains("bad.ron:3:"), "{err}");
+    assert_eq!(tooth_entities(&mut app).len(), 32);
+    assert_eq!(app.world().resource::<ActiveCase>().case.case.name, "case2");
+    std::fs::remove_dir_all(dir).ok();
+}
