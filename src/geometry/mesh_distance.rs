@@ -333,10 +333,10 @@ fn deepest_point(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, 
         if b_box.distance_squared_to_point(p) > 0.0 || !point_inside_mesh(b, p) {
             continue;
         }
-        if let Some((q, d)) = closest_point_on_mesh(b, p) {
-            if d > best.0 {
-                best = (d, pose_b.transform_point(p), pose_b.transform_point(q));
-            }
+        if let Some((q, d)) = closest_point_on_mesh(b, p)
+            && d > best.0
+        {
+            best = (d, pose_b.transform_point(p), pose_b.transform_point(q));
         }
     }
     best

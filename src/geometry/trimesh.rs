@@ -448,7 +448,7 @@ pub(crate) mod tests {
         let mut b = cuboid(Vec3::ONE.with_z(0.0), Vec3::new(2.0, 2.0, 1.0));
         let offset = a.vertices.len() as u32;
         let mut m = a.clone();
-        m.vertices.extend(b.vertices.drain(..));
+        m.vertices.append(&mut b.vertices);
         for t in b.triangles {
             m.triangles.push(t.map(|i| match i {
                 0 => 3,

@@ -68,9 +68,10 @@ pub(super) fn attach_tooth_meshes(
     }
 }
 
-pub(super) fn hide_extracted(
-    mut teeth: Query<&mut Visibility, (With<Tooth>, With<Extracted>, Changed<Visibility>)>,
-) {
+/// Extracted teeth whose visibility was just set (e.g. when their mesh was attached).
+type NewlyShownExtracted = (With<Tooth>, With<Extracted>, Changed<Visibility>);
+
+pub(super) fn hide_extracted(mut teeth: Query<&mut Visibility, NewlyShownExtracted>) {
     for mut v in &mut teeth {
         if *v != Visibility::Hidden {
             *v = Visibility::Hidden;

@@ -19,16 +19,14 @@
 //! 3. The upper arch is lowered onto the lower until the least exact gap between the arches is
 //!    `occlusal_gap` (bisection on its height).
 
-use std::{
-    collections::{BTreeMap, HashMap},
-    sync::{Arc, Mutex, OnceLock},
-};
+use std::{collections::BTreeMap, sync::Arc};
 
 use glam::{Mat3, Quat, Vec2, Vec3};
 use serde::Serialize;
 
 use super::{
     fdi::{Arch, Fdi, Side, ToothKind},
+    memo::Memo,
     tooth_shape::{ShapeSet, ToothGeometry},
 };
 use crate::geometry::{Aabb, Pose, mesh_separation};
@@ -176,22 +174,12 @@ pub struct Arrangement {
 impl Arrangement {
     /// The default-layout arrangement for a resolution and spaces, computed once per process.
     pub fn shared(shapes: &ShapeSet, spaces: &Spaces) -> Arc<Arrangement> {
-        type Key = (u32, Vec<(Fdi, u32)>);
-        static CACHE: OnceLock<Mutex<HashMap<Key, Arc<OnceLock<Arc<Arrangement>>>>>> =
-            OnceLock::new();
+        static CACHE: Memo<(u32, Vec<(Fdi, u32)>), Arrangement> = Memo::new();
         let key = (
             shapes.resolution.vertices,
             spaces.iter().map(|(f, s)| (*f, s.to_bits())).collect(),
         );
-        let cell = {
-            let mut map = CACHE
-                .get_or_init(Default::default)
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            map.entry(key).or_default().clone()
-        };
-        cell.get_or_init(|| Arc::new(arrange(shapes, &ArchLayout::default(), spaces)))
-            .clone()
+        CACHE.get_or_build(key, || arrange(shapes, &ArchLayout::default(), spaces))
     }
 
     /// The pose of a tooth.

@@ -464,14 +464,14 @@ impl Case {
     /// Cross-field checks: (field, offending token, message).
     fn check(&self) -> Result<(), (&'static str, Option<String>, String)> {
         let present = self.present();
-        if let Some(r) = self.resolution {
-            if !(20..=200_000).contains(&r) {
-                return Err((
-                    "resolution",
-                    Some(r.to_string()),
-                    format!("resolution must be 20–200000 vertices, got {r}"),
-                ));
-            }
+        if let Some(r) = self.resolution
+            && !(20..=200_000).contains(&r)
+        {
+            return Err((
+                "resolution",
+                Some(r.to_string()),
+                format!("resolution must be 20–200000 vertices, got {r}"),
+            ));
         }
         for f in &self.extracted.0 {
             if !present.contains(f) {

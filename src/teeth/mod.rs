@@ -11,6 +11,7 @@ pub mod components;
 pub mod dentition;
 pub mod fdi;
 pub mod frame;
+mod memo;
 pub mod plugin;
 pub mod shape;
 pub mod tooth_shape;

@@ -1,10 +1,7 @@
 //! `ToothGeometry`: a tooth's mesh, its triangle hierarchy and its anatomical frame, shared by every
 //! tooth of the same type (mirrored teeth included) through an `Arc`.
 
-use std::{
-    collections::HashMap,
-    sync::{Arc, Mutex, OnceLock},
-};
+use std::sync::Arc;
 
 use glam::Vec3;
 
@@ -12,6 +9,7 @@ use super::{
     anatomy::{ToothAnatomy, anatomy},
     fdi::{Arch, ToothKind},
     frame::{CentreParameters, ToothFrame},
+    memo::Memo,
     shape::{ToothResolution, ToothSolid},
 };
 use crate::geometry::{MeshRef, TriMesh, TriangleBvh};
@@ -118,16 +116,7 @@ impl ShapeSet {
 
     /// The shared set for a resolution, built once per process.
     pub fn shared(resolution: ToothResolution) -> Arc<ShapeSet> {
-        static CACHE: OnceLock<Mutex<HashMap<ToothResolution, Arc<OnceLock<Arc<ShapeSet>>>>>> =
-            OnceLock::new();
-        let cell = {
-            let mut map = CACHE
-                .get_or_init(Default::default)
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            map.entry(resolution).or_default().clone()
-        };
-        cell.get_or_init(|| Arc::new(Self::build(resolution)))
-            .clone()
+        static CACHE: Memo<ToothResolution, ShapeSet> = Memo::new();
+        CACHE.get_or_build(resolution, || Self::build(resolution))
     }
 }

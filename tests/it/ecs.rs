@@ -20,24 +20,27 @@ fn create_app() -> App {
     app
 }
 
-/// Sends a load request and updates until the case is in the world (or fails).
+/// Sends a load request and updates until the case is in the world (or fails). Cursors start
+/// after the messages already written, so an earlier load's messages are not mistaken for this one's.
 fn load(app: &mut App, case: &str) -> Result<(), String> {
+    let mut loaded = app
+        .world()
+        .resource::<Messages<CaseLoaded>>()
+        .get_cursor_current();
+    let mut failed = app
+        .world()
+        .resource::<Messages<CaseLoadFailed>>()
+        .get_cursor_current();
     app.world_mut().write_message(LoadCase(case.to_owned()));
     for _ in 0..2000 {
         app.update();
-        let loaded = app
-            .world()
-            .resource::<Messages<CaseLoaded>>()
-            .iter_current_update_messages()
-            .count()
-            > 0;
-        if loaded {
+        let world = app.world();
+        if let Some(done) = loaded.read(world.resource::<Messages<CaseLoaded>>()).last() {
+            assert_eq!(done.teeth, 32, "every case loaded here has all 32 teeth");
             return Ok(());
         }
-        if let Some(e) = app
-            .world()
-            .resource::<Messages<CaseLoadFailed>>()
-            .iter_current_update_messages()
+        if let Some(e) = failed
+            .read(world.resource::<Messages<CaseLoadFailed>>())
             .next()
         {
             return Err(e.0.to_string());

@@ -2,5 +2,6 @@
 
 mod cli;
 mod ecs;
+mod geometry_props;
 mod oracle;
 mod teeth;
