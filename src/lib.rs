@@ -12,6 +12,9 @@
 //! | [`teeth::TeethModelPlugin`] | [`teeth`] | patient cases, tooth entities with shared shapes |
 //! | `OcclusionViewPlugin` (feature `viewer`) | `occlusion_view` | rendering, orbit camera |
 //!
+//! [`sphere_tree`] holds the sphere-tree data structure, its coverage check, `.sph` I/O, the octree
+//! builder and fit metrics (engine-free; its plugin comes with the sphere-tree work).
+//!
 //! [`OrthoSimPlugins`] adds every simulation plugin; the viewer is added separately so the
 //! simulation runs the same with or without a window.
 
@@ -19,6 +22,7 @@ pub mod analysis;
 pub mod geometry;
 #[cfg(feature = "viewer")]
 pub mod occlusion_view;
+pub mod sphere_tree;
 pub mod teeth;
 
 use bevy::{app::PluginGroupBuilder, prelude::*};

@@ -11,6 +11,7 @@ pub mod decimate;
 pub mod mass;
 pub mod mesh_distance;
 pub mod pose;
+pub mod sphere;
 pub mod trimesh;
 
 pub use aabb::Aabb;
@@ -22,4 +23,5 @@ pub use closest::{
 pub use mass::MassProperties;
 pub use mesh_distance::{MeshRef, MeshSeparation, mesh_separation};
 pub use pose::Pose;
+pub use sphere::Sphere;
 pub use trimesh::{MeshError, TriMesh};

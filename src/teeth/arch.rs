@@ -228,7 +228,24 @@ fn gap(a: &ToothGeometry, pa: &Pose, b: &ToothGeometry, pb: &Pose) -> f32 {
     mesh_separation(a.mesh_ref(), pa, b.mesh_ref(), pb).signed_gap()
 }
 
-/// Finds x in [lo, hi] with f(x) = target for an increasing f, widening the bracket if needed.
+/// Bisection for an increasing f bracketed by f(lo) < target <= f(hi): returns a point within
+/// 1e-5 of the crossing on the `hi` side, so f there is at least `target` (never closer than asked).
+fn bisect_bracketed(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, target: f32) -> f32 {
+    for _ in 0..40 {
+        if hi - lo < 1e-5 {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// Finds x with f(x) = target for an increasing f, widening [lo, hi] until it brackets the target.
 fn solve_increasing(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, target: f32) -> f32 {
     for _ in 0..20 {
         if f(lo) <= target {
@@ -242,19 +259,18 @@ fn solve_increasing(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, tar
         }
         hi += hi - lo;
     }
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo < 1e-5 {
-            break;
-        }
+    bisect_bracketed(f, lo, hi, target)
+}
+
+/// Finds x in [lo, hi] where an increasing f crosses `target`, clamped to the ends.
+fn bisect_clamped(mut f: impl FnMut(f32) -> f32, lo: f32, hi: f32, target: f32) -> f32 {
+    if f(lo) >= target {
+        return lo;
     }
-    // `hi` satisfies f >= target: never closer than asked.
-    hi
+    if f(hi) <= target {
+        return hi;
+    }
+    bisect_bracketed(f, lo, hi, target)
 }
 
 /// Places one arch along its curve with adjacent crowns `contact_gap` apart.
@@ -335,25 +351,6 @@ fn molar_measures(shapes: &ShapeSet, upper: &[(Fdi, Pose)], lower: &[(Fdi, Pose)
         / 2.0;
     let all: Vec<(Fdi, Pose)> = upper.iter().chain(lower).copied().collect();
     Vec2::new(overlap, measure_occlusion(shapes, &all).molar_relation_mm)
-}
-
-/// Finds x in [lo, hi] where an increasing f crosses `target`, clamped to the ends.
-fn bisect_clamped(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, target: f32) -> f32 {
-    if f(lo) >= target {
-        return lo;
-    }
-    if f(hi) <= target {
-        return hi;
-    }
-    for _ in 0..30 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Solves the upper arch form's width and depth so that the upper first molars stand

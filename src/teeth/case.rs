@@ -27,6 +27,13 @@ pub const MAX_FORCE_N: f32 = 50.0;
 /// Largest torque accepted on one load (N·mm); orthodontic moments are up to about 30 N·mm.
 pub const MAX_TORQUE_NMM: f32 = 500.0;
 
+/// Largest offset of a tooth from its place in the arch (mm per component).
+pub const MAX_OFFSET_MM: f32 = 20.0;
+/// Largest offset rotation of a tooth (degrees per component).
+pub const MAX_OFFSET_DEG: f32 = 90.0;
+/// Largest extra space at one contact (mm).
+pub const MAX_SPACE_MM: f32 = 15.0;
+
 /// A case file that could not be read or is not valid.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum CaseError {
@@ -494,11 +501,40 @@ impl Case {
                     Ok(())
                 }
             };
-        for f in self.spaces.0.keys() {
+        for (f, space) in &self.spaces.0 {
             absent("spaces", f)?;
+            if space.0 > MAX_SPACE_MM {
+                return Err((
+                    "spaces",
+                    Some(f.to_string()),
+                    format!(
+                        "space of {} mm at tooth {f} is beyond the {MAX_SPACE_MM} mm accepted",
+                        space.0
+                    ),
+                ));
+            }
         }
-        for f in self.offsets.0.keys() {
+        for (f, offset) in &self.offsets.0 {
             absent("offsets", f)?;
+            let (t, r) = (offset.translation, offset.rotation_deg);
+            if [t.0, t.1, t.2].iter().any(|c| c.0.abs() > MAX_OFFSET_MM) {
+                return Err((
+                    "offsets",
+                    Some(f.to_string()),
+                    format!(
+                        "offset of tooth {f} is beyond the {MAX_OFFSET_MM} mm accepted per axis"
+                    ),
+                ));
+            }
+            if [r.0, r.1, r.2].iter().any(|c| c.0.abs() > MAX_OFFSET_DEG) {
+                return Err((
+                    "offsets",
+                    Some(f.to_string()),
+                    format!(
+                        "rotation of tooth {f} is beyond the {MAX_OFFSET_DEG}° accepted per axis"
+                    ),
+                ));
+            }
         }
         for f in self.meshes.0.keys() {
             absent("meshes", f)?;
@@ -637,6 +673,11 @@ mod tests {
         assert!(m.contains("duplicate"), "{m}");
         let (_, _, m) =
             err("Case(name: \"x\", loads: [(teeth: [16], force: World(0.0, 0.0, 1e9))])");
+        assert!(m.contains("beyond"), "{m}");
+        let (l, c, m) = err(
+            "Case(\n  name: \"x\",\n  offsets: {\n    12: (translation: (0.0, 500.0, 0.0)),\n  },\n)",
+        );
+        assert_eq!((l, c), (4, 5), "{m}");
         assert!(m.contains("beyond"), "{m}");
         let (l, c, m) = err("");
         assert_eq!((l, c), (1, 1));

@@ -1,0 +1,209 @@
+//! `Sphere` and the smallest sphere enclosing a point set (Welzl 1991).
+
+use glam::{DVec3, Vec3};
+
+/// A sphere: centre and radius (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub centre: Vec3,
+    /// Radius (≥ 0).
+    pub radius: f32,
+}
+
+impl Sphere {
+    /// A sphere from its centre and radius.
+    pub const fn new(centre: Vec3, radius: f32) -> Self {
+        Self { centre, radius }
+    }
+
+    /// True when `p` lies inside or on the sphere (exact comparison of squared distances).
+    #[inline]
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.centre.distance_squared(p) <= self.radius * self.radius
+    }
+
+    /// True when the spheres overlap or touch.
+    #[inline]
+    pub fn overlaps(&self, o: &Sphere) -> bool {
+        let r = self.radius + o.radius;
+        self.centre.distance_squared(o.centre) <= r * r
+    }
+
+    /// Volume (mm³).
+    pub fn volume(&self) -> f64 {
+        4.0 / 3.0 * std::f64::consts::PI * (self.radius as f64).powi(3)
+    }
+
+    /// The smallest sphere containing every point (Welzl's algorithm in its iterative form, in f64,
+    /// over a deterministic shuffle), then grown to the largest f32 distance from the centre so that
+    /// every point passes [`Sphere::contains`]. Exact up to rounding; empty input gives a zero sphere
+    /// at the origin.
+    pub fn enclosing(points: &[Vec3]) -> Sphere {
+        if points.is_empty() {
+            return Sphere::new(Vec3::ZERO, 0.0);
+        }
+        let mut p: Vec<DVec3> = points.iter().map(|v| v.as_dvec3()).collect();
+        // Deterministic shuffle: the expected linear time needs a random order.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for i in (1..p.len()).rev() {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            p.swap(i, (state % (i as u64 + 1)) as usize);
+        }
+        let inside = |s: &(DVec3, f64), q: DVec3| q.distance(s.0) <= s.1 * (1.0 + 1e-12) + 1e-12;
+        let mut s = (p[0], 0.0);
+        for i in 1..p.len() {
+            if inside(&s, p[i]) {
+                continue;
+            }
+            s = (p[i], 0.0);
+            for j in 0..i {
+                if inside(&s, p[j]) {
+                    continue;
+                }
+                s = sphere2(p[i], p[j]);
+                for k in 0..j {
+                    if inside(&s, p[k]) {
+                        continue;
+                    }
+                    s = sphere3(p[i], p[j], p[k]);
+                    for l in 0..k {
+                        if !inside(&s, p[l]) {
+                            s = sphere4(p[i], p[j], p[k], p[l]);
+                        }
+                    }
+                }
+            }
+        }
+        let centre = s.0.as_vec3();
+        let radius = points
+            .iter()
+            .map(|q| q.distance(centre))
+            .fold(0.0f32, f32::max);
+        // One ulp more so that the squared comparison in `contains` holds for every point.
+        Sphere::new(centre, radius.next_up())
+    }
+}
+
+fn sphere2(a: DVec3, b: DVec3) -> (DVec3, f64) {
+    let c = (a + b) * 0.5;
+    (c, a.distance(c))
+}
+
+/// The smallest sphere with a, b, c on its surface (centre in their plane).
+fn sphere3(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
+    let (ab, ac) = (b - a, c - a);
+    let n = ab.cross(ac);
+    let d = 2.0 * n.length_squared();
+    if d <= 1e-24 * ab.length_squared().max(ac.length_squared()).powi(2) {
+        // Collinear: the sphere on the farthest pair.
+        return [sphere2(a, b), sphere2(a, c), sphere2(b, c)]
+            .into_iter()
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap_or((a, 0.0));
+    }
+    let offset = (n.cross(ab) * ac.length_squared() + ac.cross(n) * ab.length_squared()) / d;
+    (a + offset, offset.length())
+}
+
+/// The sphere through a, b, c, d (their circumsphere); coplanar sets fall back to the smallest
+/// sphere of the triangle that contains the fourth point.
+fn sphere4(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (DVec3, f64) {
+    let (u, v, w) = (b - a, c - a, d - a);
+    let det = 2.0 * u.dot(v.cross(w));
+    let scale = u.length() * v.length() * w.length();
+    if det.abs() <= 1e-12 * scale.max(1e-300) {
+        let candidates = [
+            sphere3(a, b, c),
+            sphere3(a, b, d),
+            sphere3(a, c, d),
+            sphere3(b, c, d),
+        ];
+        let all = [a, b, c, d];
+        return candidates
+            .into_iter()
+            .filter(|s| {
+                all.iter()
+                    .all(|q| q.distance(s.0) <= s.1 * (1.0 + 1e-9) + 1e-12)
+            })
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap_or_else(|| {
+                let c = (a + b + c + d) / 4.0;
+                (c, all.iter().map(|q| q.distance(c)).fold(0.0, f64::max))
+            });
+    }
+    let offset = (v.cross(w) * u.length_squared()
+        + w.cross(u) * v.length_squared()
+        + u.cross(v) * w.length_squared())
+        / det;
+    (a + offset, offset.length())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn enclosing_spheres_of_simple_sets() {
+        let s = Sphere::enclosing(&[
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.2, 0.0),
+        ]);
+        assert!(
+            (s.radius - 1.0).abs() < 1e-5 && s.centre.length() < 1e-5,
+            "{s:?}"
+        );
+        // Regular tetrahedron: circumradius sqrt(3/8) * edge.
+        let t = [
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(1.0, -1.0, -1.0),
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(-1.0, -1.0, 1.0),
+        ];
+        let s = Sphere::enclosing(&t);
+        assert!(
+            (s.radius - 3f32.sqrt()).abs() < 1e-5 && s.centre.length() < 1e-5,
+            "{s:?}"
+        );
+    }
+
+    #[test]
+    fn enclosing_sphere_contains_every_point_and_is_small() {
+        let mut state = 7u32;
+        let mut rnd = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        for n in [1usize, 2, 5, 50, 2000] {
+            let pts: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(rnd(), rnd() * 3.0, rnd()) * 4.0)
+                .collect();
+            let s = Sphere::enclosing(&pts);
+            assert!(pts.iter().all(|p| s.contains(*p)), "n = {n}");
+            // Never larger than the box's circumscribed sphere.
+            let b = crate::geometry::Aabb::from_points(pts.iter().copied());
+            assert!(
+                s.radius <= 0.5 * b.extent().length() + 1e-4,
+                "n = {n}: {s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn coplanar_and_duplicate_points() {
+        let pts = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::X + Vec3::Y,
+            Vec3::X,
+            Vec3::ZERO,
+        ];
+        let s = Sphere::enclosing(&pts);
+        assert!((s.radius - 0.5f32.sqrt()).abs() < 1e-5, "{s:?}");
+        assert!(pts.iter().all(|p| s.contains(*p)));
+    }
+}

@@ -1,0 +1,26 @@
+//! Sphere trees: hierarchies of bounding spheres over a tooth mesh, for fast, conservative collision.
+//!
+//! Layout ([`SphereTree`]): a flat B-ary tree in Bradshaw's `.sph` index order (children of node n
+//! at n·B+1 … n·B+B, empty slots marked), levels counted including the root ("depth 4" = levels
+//! 0–3). Spheres are in the tooth's local frame. Each leaf lists the triangles it touches.
+//!
+//! **Invariant** ([`coverage::check_coverage`]): (1) every point of the tooth surface lies inside at
+//! least one leaf sphere; (2) every inner sphere contains all the surface its leaves are responsible
+//! for. It is checked exactly: each triangle is split recursively until every piece has its three
+//! vertices inside one leaf sphere (then, spheres being convex, the whole piece is inside it); that
+//! leaf is responsible for the piece, and every ancestor of it must contain the piece's vertices too.
+//! A piece still uncovered past the depth limit fails the check. The invariant is what makes
+//! sphere-tree collision conservative: two surfaces cannot touch unless some pair of leaves (and
+//! every pair of their ancestors) overlaps, so a descent that prunes non-overlapping pairs has no
+//! false negatives against the exact mesh.
+//!
+//! Builders: [`octree`] (Hubbard 1993). Files: [`sph`] reads and writes Bradshaw's format.
+
+pub mod coverage;
+pub mod metrics;
+pub mod octree;
+pub mod sph;
+pub mod tree;
+
+pub use coverage::{Coverage, check_coverage};
+pub use tree::SphereTree;
