@@ -10,10 +10,9 @@
 //! | plugin | module | what it adds |
 //! |---|---|---|
 //! | [`teeth::TeethModelPlugin`] | [`teeth`] | patient cases, tooth entities with shared shapes |
+//! | [`sphere_tree::SphereTreePlugin`] | [`sphere_tree`] | sphere trees per tooth shape, built in the background |
 //! | `OcclusionViewPlugin` (feature `viewer`) | `occlusion_view` | rendering, orbit camera |
-//!
-//! [`sphere_tree`] holds the sphere-tree data structure, its coverage check, `.sph` I/O, the octree
-//! builder and fit metrics (engine-free; its plugin comes with the sphere-tree work).
+
 //!
 //! [`OrthoSimPlugins`] adds every simulation plugin; the viewer is added separately so the
 //! simulation runs the same with or without a window.
@@ -22,6 +21,7 @@ pub mod analysis;
 pub mod geometry;
 #[cfg(feature = "viewer")]
 pub mod occlusion_view;
+pub mod parallel;
 pub mod sphere_tree;
 pub mod teeth;
 
@@ -32,13 +32,16 @@ use bevy::{app::PluginGroupBuilder, prelude::*};
 /// | plugin | role |
 /// |---|---|
 /// | [`teeth::TeethModelPlugin`] | loads cases, spawns teeth |
+/// | [`sphere_tree::SphereTreePlugin`] | builds each tooth shape's sphere tree in the background |
 ///
 /// Swap one out with `OrthoSimPlugins.build().disable::<…>()`.
 pub struct OrthoSimPlugins;
 
 impl PluginGroup for OrthoSimPlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(teeth::TeethModelPlugin::default())
+        PluginGroupBuilder::start::<Self>()
+            .add(teeth::TeethModelPlugin::default())
+            .add(sphere_tree::SphereTreePlugin)
     }
 }
 

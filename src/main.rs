@@ -6,6 +6,10 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use orthosim::{
     analysis::inspect,
+    sphere_tree::{
+        TreeMethod, TreeSettings,
+        report::{trees_report, write_atomic},
+    },
     teeth::{Case, Dentition},
 };
 
@@ -44,6 +48,27 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(20..=200_000))]
         resolution: Option<u32>,
     },
+    /// Build each tooth's sphere tree and report its fit (the paper's relative outside volume).
+    Trees {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "normal")]
+        case: String,
+        /// Tree builder.
+        #[arg(long, value_enum, default_value_t = TreeMethod::Octree)]
+        method: TreeMethod,
+        /// Levels including the root.
+        #[arg(long, default_value_t = 4)]
+        depth: u32,
+        /// Children per node.
+        #[arg(long, default_value_t = 8)]
+        branching: u32,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Write one Bradshaw .sph file per tooth into this folder.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -59,6 +84,23 @@ fn main() -> ExitCode {
         Command::View { case, camera } => view(&case, camera),
         #[cfg(not(feature = "viewer"))]
         Command::View { case } => view(&case),
+        Command::Trees {
+            case,
+            method,
+            depth,
+            branching,
+            json,
+            out,
+        } => run_trees(
+            &case,
+            TreeSettings {
+                method,
+                branching,
+                depth,
+            },
+            json,
+            out.as_deref(),
+        ),
         Command::Cases => {
             list_cases();
             Ok(())
@@ -150,6 +192,77 @@ fn run_inspect(case: &str, json: bool, resolution: Option<u32>) -> Result<()> {
     println!(
         "overjet {:.2} mm, overbite {:.2} mm, molar relation {:+.2} mm (0 = class I)",
         o.overjet_mm, o.overbite_mm, o.molar_relation_mm
+    );
+    Ok(())
+}
+
+fn run_trees(
+    case: &str,
+    settings: TreeSettings,
+    json: bool,
+    out: Option<&std::path::Path>,
+) -> Result<()> {
+    settings.validate()?;
+    let dentition = Dentition::build(Case::resolve(case)?)?;
+    let progress = std::io::stderr().is_terminal();
+    let bar = |done: usize, total: usize| {
+        if progress {
+            let filled = done * 30 / total.max(1);
+            eprint!(
+                "\rbuilding trees [{}{}] {done}/{total}",
+                "#".repeat(filled),
+                " ".repeat(30 - filled)
+            );
+            if done == total {
+                eprintln!();
+            }
+        }
+    };
+    let (report, trees) = trees_report(&dentition, settings, &bar)?;
+    if let Some(dir) = out {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create folder", dir.display()))?;
+        for (fdi, tree) in &trees {
+            let path = dir.join(format!("{fdi}.sph"));
+            write_atomic(&path, &tree.to_sph())
+                .with_context(|| format!("{}: cannot write", path.display()))?;
+        }
+    }
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).context("writing JSON")?
+        );
+        return Ok(());
+    }
+    println!(
+        "{:?} trees, branching {}, depth {} ({} teeth)",
+        report.method,
+        report.branching,
+        report.depth,
+        report.teeth.len()
+    );
+    println!(
+        "{:>4} {:>7} {:>8} {:>9} {:>12} {:>8} {:>9}",
+        "fdi", "leaves", "sov_sum", "sov_union", "overhang mm", "covered", "build ms"
+    );
+    for t in &report.teeth {
+        println!(
+            "{:>4} {:>7} {:>8.3} {:>9.3} {:>12.3} {:>8} {:>9.2}",
+            t.fdi, t.leaves, t.sov_sum, t.sov_union, t.max_overhang_mm, t.covered, t.build_ms
+        );
+    }
+    let s = &report.summary;
+    println!(
+        "sov_sum mean {:.3} (min {:.3}, max {:.3}), sov_union mean {:.3}, overhang mean {:.3} mm, leaves mean {:.1}, all covered: {}, build {:.1} ms",
+        s.sov_sum_mean,
+        s.sov_sum_min,
+        s.sov_sum_max,
+        s.sov_union_mean,
+        s.max_overhang_mm_mean,
+        s.leaves_mean,
+        s.all_covered,
+        s.build_ms_total
     );
     Ok(())
 }

@@ -14,13 +14,20 @@
 //! every pair of their ancestors) overlaps, so a descent that prunes non-overlapping pairs has no
 //! false negatives against the exact mesh.
 //!
-//! Builders: [`octree`] (Hubbard 1993). Files: [`sph`] reads and writes Bradshaw's format.
+//! Builders: [`octree`] (Hubbard 1993). Files: [`sph`] reads and writes Bradshaw's format. Fit:
+//! [`metrics`]. ECS: [`SphereTreePlugin`] builds trees in the background. Reports: [`report`] (the
+//! `orthosim trees` command).
 
+pub mod build;
 pub mod coverage;
 pub mod metrics;
 pub mod octree;
+pub mod plugin;
+pub mod report;
 pub mod sph;
 pub mod tree;
 
+pub use build::{TreeMethod, TreeSettings};
 pub use coverage::{Coverage, check_coverage};
+pub use plugin::{SphereTreePlugin, SphereTreeSettings, SphereTreeSystems, ToothSphereTree};
 pub use tree::SphereTree;

@@ -91,27 +91,10 @@ impl ShapeSet {
             .into_iter()
             .flat_map(|a| ToothKind::ALL.into_iter().map(move |k| (a, k)))
             .collect();
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(jobs.len());
-        let mut slots: Vec<Option<Arc<ToothGeometry>>> = vec![None; jobs.len()];
-        std::thread::scope(|scope| {
-            let chunks: Vec<_> = slots
-                .chunks_mut(jobs.len().div_ceil(threads))
-                .zip(jobs.chunks(jobs.len().div_ceil(threads)))
-                .collect();
-            for (out, work) in chunks {
-                scope.spawn(move || {
-                    for (slot, &(arch, kind)) in out.iter_mut().zip(work) {
-                        *slot = Some(Arc::new(ToothGeometry::procedural(arch, kind, resolution)));
-                    }
-                });
-            }
+        let shapes = crate::parallel::parallel_map(&jobs, |&(arch, kind)| {
+            Arc::new(ToothGeometry::procedural(arch, kind, resolution))
         });
-        Self {
-            resolution,
-            shapes: slots.into_iter().flatten().collect(),
-        }
+        Self { resolution, shapes }
     }
 
     /// The shared set for a resolution, built once per process.

@@ -125,7 +125,86 @@ fn help_lists_the_subcommands() {
     let out = orthosim(&["--help"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    for sub in ["view", "cases", "inspect"] {
+    for sub in ["view", "cases", "inspect", "trees"] {
         assert!(text.contains(sub), "{text}");
     }
+}
+
+#[test]
+fn trees_reports_covering_octrees_and_writes_sph_files() {
+    let dir = std::env::temp_dir().join(format!("orthosim-trees-{}", std::process::id()));
+    let out = orthosim(&[
+        "trees",
+        "--case",
+        "normal",
+        "--method",
+        "octree",
+        "--depth",
+        "3",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(
+        (
+            v["method"].as_str(),
+            v["branching"].as_u64(),
+            v["depth"].as_u64()
+        ),
+        (Some("octree"), Some(8), Some(3))
+    );
+    let teeth = v["teeth"].as_array().unwrap();
+    assert_eq!(teeth.len(), 32);
+    for t in teeth {
+        for key in [
+            "fdi",
+            "leaves",
+            "sov_sum",
+            "sov_union",
+            "max_overhang_mm",
+            "covered",
+            "build_ms",
+        ] {
+            assert!(t.get(key).is_some(), "missing {key} in {t}");
+        }
+        assert!(
+            t["sov_sum"].as_f64().unwrap() >= t["sov_union"].as_f64().unwrap() - 1e-9,
+            "{t}"
+        );
+        let leaves = t["leaves"].as_u64().unwrap();
+        assert!((1..=64).contains(&leaves), "{t}");
+    }
+    let s = &v["summary"];
+    for key in [
+        "sov_sum_mean",
+        "sov_sum_min",
+        "sov_sum_max",
+        "sov_union_mean",
+        "max_overhang_mm_mean",
+        "leaves_mean",
+        "all_covered",
+        "build_ms_total",
+    ] {
+        assert!(s.get(key).is_some(), "missing {key} in {s}");
+    }
+    assert_eq!(s["all_covered"], true);
+    let written = std::fs::read_to_string(dir.join("36.sph")).unwrap();
+    let tree = orthosim::sphere_tree::SphereTree::from_sph(&written).unwrap();
+    assert_eq!((tree.levels, tree.branching), (3, 8));
+    assert_eq!(
+        tree.leaves().count() as u64,
+        teeth.iter().find(|t| t["fdi"] == 36).unwrap()["leaves"]
+            .as_u64()
+            .unwrap()
+    );
+    let refused = orthosim(&["trees", "--method", "octree", "--branching", "4"]);
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("branching 8"));
+    std::fs::remove_dir_all(dir).ok();
 }

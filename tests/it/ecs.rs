@@ -165,3 +165,34 @@ fn a_bad_case_leaves_the_scene_as_it_was() {
     assert_eq!(app.world().resource::<ActiveCase>().case.case.name, "case2");
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn every_tooth_gets_a_covering_sphere_tree() {
+    use orthosim::sphere_tree::{ToothSphereTree, check_coverage, coverage::DEFAULT_SPLIT_DEPTH};
+    let mut app = create_app();
+    load(&mut app, "normal").unwrap();
+    let mut ready = 0;
+    for _ in 0..3000 {
+        app.update();
+        let mut q = app
+            .world_mut()
+            .query_filtered::<(), (With<Tooth>, With<ToothSphereTree>)>();
+        ready = q.iter(app.world()).count();
+        if ready == 32 {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(ready, 32, "every tooth has its tree");
+    let mut q = app
+        .world_mut()
+        .query::<(&Tooth, &ToothShape, &ToothSphereTree)>();
+    let mut distinct = std::collections::HashSet::new();
+    for (tooth, shape, tree) in q.iter(app.world()) {
+        distinct.insert(Arc::as_ptr(&tree.0) as usize);
+        let c = check_coverage(&tree.0, &shape.mesh, DEFAULT_SPLIT_DEPTH);
+        assert!(c.covered, "{}: {c:?}", tooth.id);
+        assert_eq!(tree.levels, 4);
+    }
+    assert_eq!(distinct.len(), 16, "mirrored teeth share one tree");
+}

@@ -1,0 +1,136 @@
+//! `SphereTreePlugin`: builds each distinct tooth shape's sphere tree in the background and attaches
+//! it to every tooth with that shape.
+//!
+//! A tooth without a [`ToothSphereTree`] is not ready: collision systems must skip it rather than
+//! report a result. Changing [`SphereTreeSettings`] drops every tree and rebuilds.
+
+use std::{collections::HashMap, sync::Arc};
+
+use bevy::{
+    prelude::*,
+    tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future},
+};
+
+use super::{
+    build::{TreeBuildError, TreeSettings},
+    tree::SphereTree,
+};
+use crate::teeth::{ToothGeometry, ToothShape};
+
+/// The settings trees are built with.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct SphereTreeSettings(pub TreeSettings);
+
+/// A tooth's sphere tree (shared by teeth of the same shape).
+#[derive(Component, Clone, Debug, Deref)]
+pub struct ToothSphereTree(pub Arc<SphereTree>);
+
+/// A tree being built on the async compute pool.
+type BuildTask = Task<Result<SphereTree, TreeBuildError>>;
+
+/// Trees built or being built, keyed by shape (the `Arc` is held so the key stays unique).
+#[derive(Resource, Default)]
+struct TreeStore {
+    built: HashMap<usize, (Arc<ToothGeometry>, Arc<SphereTree>)>,
+    pending: HashMap<usize, (Arc<ToothGeometry>, BuildTask)>,
+    failed: HashMap<usize, Arc<ToothGeometry>>,
+}
+
+/// System sets of the sphere-tree plugin, in `Update`.
+#[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum SphereTreeSystems {
+    /// Drop trees when the settings change.
+    Invalidate,
+    /// Start builds and attach finished trees.
+    Build,
+}
+
+/// Builds sphere trees for tooth shapes in the background.
+#[derive(Default)]
+pub struct SphereTreePlugin;
+
+impl Plugin for SphereTreePlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SphereTreeSettings>()
+            .init_resource::<TreeStore>()
+            .configure_sets(
+                Update,
+                (SphereTreeSystems::Invalidate, SphereTreeSystems::Build).chain(),
+            )
+            .add_systems(
+                Update,
+                (
+                    invalidate_on_settings_change
+                        .run_if(resource_changed::<SphereTreeSettings>)
+                        .in_set(SphereTreeSystems::Invalidate),
+                    (finish_builds, start_builds_and_attach)
+                        .chain()
+                        .in_set(SphereTreeSystems::Build),
+                ),
+            );
+    }
+}
+
+fn key(shape: &ToothShape) -> usize {
+    Arc::as_ptr(&shape.0) as usize
+}
+
+fn invalidate_on_settings_change(
+    mut commands: Commands,
+    mut store: ResMut<TreeStore>,
+    teeth: Query<Entity, With<ToothSphereTree>>,
+) {
+    *store = TreeStore::default();
+    for e in &teeth {
+        commands.entity(e).try_remove::<ToothSphereTree>();
+    }
+}
+
+fn finish_builds(mut store: ResMut<TreeStore>) {
+    let mut finished = Vec::new();
+    for (k, (_, task)) in store.pending.iter_mut() {
+        if let Some(result) = block_on(future::poll_once(task)) {
+            finished.push((*k, result));
+        }
+    }
+    for (k, result) in finished {
+        let Some((geometry, _)) = store.pending.remove(&k) else {
+            continue;
+        };
+        match result {
+            Ok(tree) => {
+                store.built.insert(k, (geometry, Arc::new(tree)));
+            }
+            Err(e) => {
+                error!(
+                    "sphere tree of a {:?} could not be built: {e}",
+                    geometry.kind
+                );
+                store.failed.insert(k, geometry);
+            }
+        }
+    }
+}
+
+fn start_builds_and_attach(
+    mut commands: Commands,
+    mut store: ResMut<TreeStore>,
+    settings: Res<SphereTreeSettings>,
+    teeth: Query<(Entity, &ToothShape), Without<ToothSphereTree>>,
+) {
+    for (entity, shape) in &teeth {
+        let k = key(shape);
+        if let Some((_, tree)) = store.built.get(&k) {
+            // The tooth may be despawned by a case reload later this frame.
+            commands
+                .entity(entity)
+                .try_insert(ToothSphereTree(tree.clone()));
+        } else if !store.pending.contains_key(&k) && !store.failed.contains_key(&k) {
+            let geometry = shape.0.clone();
+            let settings = settings.0;
+            let job = geometry.clone();
+            let task = AsyncComputeTaskPool::get().spawn(async move { settings.build(&job.mesh) });
+            store.pending.insert(k, (geometry, task));
+        }
+    }
+}
