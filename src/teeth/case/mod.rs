@@ -4,22 +4,27 @@
 //! unknown fields, unknown or duplicate teeth, non-finite numbers, negative sizes, loads on extracted
 //! or absent teeth, absurd load magnitudes. See the README for the schema.
 
-use std::{collections::BTreeMap, fmt, path::Path};
+mod parts;
+mod values;
 
-use serde::{
-    Deserialize, Deserializer, Serialize,
-    de::{self, MapAccess, SeqAccess, Visitor},
-};
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+pub use parts::{
+    CaseConstraint, CaseLoad, CaseOffset, CaseVector, CaseWires, Freedoms, PresentTeeth, WireModel,
+};
+pub use values::{Finite, NonNegative, ToothList, ToothMap};
 
 use super::{fdi::Fdi, shape::ToothResolution};
 
 /// The built-in cases: name and RON source (embedded in the binary).
 pub const BUILTIN_CASES: [(&str, &str); 4] = [
-    ("normal", include_str!("../../assets/cases/normal.ron")),
-    ("case1", include_str!("../../assets/cases/case1.ron")),
-    ("case2", include_str!("../../assets/cases/case2.ron")),
-    ("case3", include_str!("../../assets/cases/case3.ron")),
+    ("normal", include_str!("../../../assets/cases/normal.ron")),
+    ("case1", include_str!("../../../assets/cases/case1.ron")),
+    ("case2", include_str!("../../../assets/cases/case2.ron")),
+    ("case3", include_str!("../../../assets/cases/case3.ron")),
 ];
 
 /// Largest force accepted on one load (N); orthodontic forces are 0.1–5 N.
@@ -62,259 +67,6 @@ pub enum CaseError {
         "unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file"
     )]
     Unknown(String),
-}
-
-/// An f32 that must be finite (NaN and infinities are refused where they are read).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-#[serde(transparent)]
-pub struct Finite(pub f32);
-
-impl<'de> Deserialize<'de> for Finite {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = f64::deserialize(d)?;
-        if !v.is_finite() || v.abs() > f32::MAX as f64 {
-            return Err(de::Error::custom(format!("number must be finite, got {v}")));
-        }
-        Ok(Self(v as f32))
-    }
-}
-
-/// A finite, non-negative f32 (sizes, limits).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-#[serde(transparent)]
-pub struct NonNegative(pub f32);
-
-impl<'de> Deserialize<'de> for NonNegative {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let Finite(v) = Finite::deserialize(d)?;
-        if v < 0.0 {
-            return Err(de::Error::custom(format!(
-                "size must not be negative, got {v}"
-            )));
-        }
-        Ok(Self(v))
-    }
-}
-
-/// A list of distinct teeth (a duplicate is an error at its position).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-#[serde(transparent)]
-pub struct ToothList(pub Vec<Fdi>);
-
-impl<'de> Deserialize<'de> for ToothList {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = ToothList;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a list of FDI tooth numbers")
-            }
-            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<ToothList, A::Error> {
-                let mut out = Vec::new();
-                while let Some(t) = seq.next_element::<Fdi>()? {
-                    if out.contains(&t) {
-                        return Err(de::Error::custom(format!("duplicate tooth {t}")));
-                    }
-                    out.push(t);
-                }
-                Ok(ToothList(out))
-            }
-        }
-        d.deserialize_seq(V)
-    }
-}
-
-/// A map keyed by tooth whose keys must be distinct.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(transparent)]
-pub struct ToothMap<T>(pub BTreeMap<Fdi, T>);
-
-impl<T> Default for ToothMap<T> {
-    fn default() -> Self {
-        Self(BTreeMap::new())
-    }
-}
-
-impl<'de, T: Deserialize<'de>> Deserialize<'de> for ToothMap<T> {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V<T>(std::marker::PhantomData<T>);
-        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
-            type Value = ToothMap<T>;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a map from FDI tooth numbers")
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ToothMap<T>, A::Error> {
-                let mut out = BTreeMap::new();
-                while let Some(k) = map.next_key::<Fdi>()? {
-                    if out.contains_key(&k) {
-                        return Err(de::Error::custom(format!("duplicate tooth {k}")));
-                    }
-                    let v = map.next_value::<T>()?;
-                    out.insert(k, v);
-                }
-                Ok(ToothMap(out))
-            }
-        }
-        d.deserialize_map(V(std::marker::PhantomData))
-    }
-}
-
-/// A vector given in the world frame or in a tooth's anatomical frame.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum CaseVector {
-    /// World frame: +x patient's left, +y up, +z anterior.
-    World(Finite, Finite, Finite),
-    /// Components along the tooth's mesial, buccal and occlusal directions (for a torque: about
-    /// those axes, right-handed). Missing components are zero.
-    Anatomical {
-        /// Towards the midline along the arch.
-        #[serde(default)]
-        mesial: Finite,
-        /// Towards the cheeks / lips.
-        #[serde(default)]
-        buccal: Finite,
-        /// Towards the occlusal plane (extrusion).
-        #[serde(default)]
-        occlusal: Finite,
-    },
-}
-
-impl Default for CaseVector {
-    fn default() -> Self {
-        Self::World(Finite(0.0), Finite(0.0), Finite(0.0))
-    }
-}
-
-impl CaseVector {
-    /// Length of the vector.
-    pub fn magnitude(&self) -> f32 {
-        let (a, b, c) = match *self {
-            Self::World(a, b, c) => (a, b, c),
-            Self::Anatomical {
-                mesial,
-                buccal,
-                occlusal,
-            } => (mesial, buccal, occlusal),
-        };
-        glam::Vec3::new(a.0, b.0, c.0).length()
-    }
-}
-
-/// A force system on a tooth or a group of teeth.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseLoad {
-    /// The loaded teeth.
-    pub teeth: ToothList,
-    /// Force (N).
-    #[serde(default)]
-    pub force: CaseVector,
-    /// Torque (N·mm).
-    #[serde(default)]
-    pub torque: CaseVector,
-    /// True: the teeth move as one block (a segment on a wire); false: each tooth gets the load.
-    #[serde(default)]
-    pub as_group: bool,
-}
-
-/// Archwire cross-section, which decides how a tooth responds to a load (paper, section 3).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum WireModel {
-    /// Rectangular wire: torque rotates about the crown centre, force translates bodily.
-    #[default]
-    Rectangular,
-    /// Round wire: force tips the tooth about a centre at 1/3 of the root length from the apex.
-    Round,
-}
-
-/// Wire models per arch, with optional per-tooth exceptions.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseWires {
-    /// Upper arch wire.
-    #[serde(default)]
-    pub upper: WireModel,
-    /// Lower arch wire.
-    #[serde(default)]
-    pub lower: WireModel,
-    /// Per-tooth exceptions.
-    #[serde(default)]
-    pub teeth: ToothMap<WireModel>,
-}
-
-/// Degrees of freedom along or about the anatomical axes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Freedoms {
-    /// Along / about the mesiodistal axis.
-    #[serde(default = "yes")]
-    pub mesial: bool,
-    /// Along / about the buccolingual axis.
-    #[serde(default = "yes")]
-    pub buccal: bool,
-    /// Along / about the long (occlusal) axis.
-    #[serde(default = "yes")]
-    pub occlusal: bool,
-}
-
-fn yes() -> bool {
-    true
-}
-
-impl Default for Freedoms {
-    fn default() -> Self {
-        Self {
-            mesial: true,
-            buccal: true,
-            occlusal: true,
-        }
-    }
-}
-
-/// Movement constraints on some teeth.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseConstraint {
-    /// The constrained teeth.
-    pub teeth: ToothList,
-    /// Allowed translations.
-    #[serde(default)]
-    pub translate: Freedoms,
-    /// Allowed rotations.
-    #[serde(default)]
-    pub rotate: Freedoms,
-    /// Largest total translation from the start pose (mm).
-    #[serde(default)]
-    pub max_translation_mm: Option<NonNegative>,
-    /// Largest total rotation from the start pose (degrees).
-    #[serde(default)]
-    pub max_rotation_deg: Option<NonNegative>,
-}
-
-/// A tooth's displacement from its place in the normal arch, in its anatomical frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseOffset {
-    /// Translation (mm) along mesial, buccal, occlusal.
-    #[serde(default)]
-    pub translation: (Finite, Finite, Finite),
-    /// Rotation (degrees) about the mesial (torque), buccal (tip) and occlusal (rotation) axes,
-    /// about the crown centre.
-    #[serde(default)]
-    pub rotation_deg: (Finite, Finite, Finite),
-}
-
-/// Which teeth the patient has.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub enum PresentTeeth {
-    /// All 32.
-    #[default]
-    All,
-    /// Only these (others are absent: not modelled at all).
-    Only(ToothList),
-    /// All but these.
-    AllBut(ToothList),
 }
 
 /// A patient case as read from RON.
@@ -463,8 +215,8 @@ impl Case {
             .get(&f)
             .copied()
             .unwrap_or(match f.arch() {
-                super::fdi::Arch::Upper => self.wire.upper,
-                super::fdi::Arch::Lower => self.wire.lower,
+                crate::teeth::fdi::Arch::Upper => self.wire.upper,
+                crate::teeth::fdi::Arch::Lower => self.wire.lower,
             })
     }
 

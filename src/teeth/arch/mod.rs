@@ -12,10 +12,11 @@
 //! 1. Each arch: the central incisors are placed symmetrically about the midline, then every tooth
 //!    distally slides along the curve until the exact triangle-level gap to its mesial neighbour is
 //!    `contact_gap` (bisection on the arc position; the gap grows monotonically with it).
-//! 2. The upper curve's width and depth are solved (Newton, on nominal tooth widths) so that the
-//!    upper first molars stand `buccal_overlap` buccal to the lower ones and their mesiobuccal cusps
-//!    sit over the lower first molars' buccal grooves (Angle class I); its front lies `overjet_offset`
-//!    ahead of the lower front.
+//! 2. The upper curve's width and depth are solved so that the upper first molars stand
+//!    `buccal_overlap` buccal to the lower ones and their mesiobuccal cusps sit over the lower first
+//!    molars' buccal grooves (Angle class I): nested bisections on a fast model (teeth at their
+//!    summed widths along the curves), corrected by what the exact placement then measures. Its
+//!    front lies `overjet_offset` ahead of the lower front.
 //! 3. The upper arch is lowered onto the lower until the least exact gap between the arches is
 //!    `occlusal_gap` (bisection on its height).
 
@@ -31,74 +32,13 @@ use super::{
 };
 use crate::geometry::{Aabb, Pose, mesh_separation};
 
-/// The beta-function arch form.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct BetaArch {
-    /// Width `W` at the distal of the second molars (mm).
-    pub width: f32,
-    /// Depth `D` from the second molars' line to the front (mm).
-    pub depth: f32,
-    /// World z of the curve's front point.
-    pub front_z: f32,
-}
+mod bisect;
+mod form;
+mod occlusion;
 
-impl BetaArch {
-    /// The point of the curve at lateral position `x` (|x| ≤ W/2), as (x, z).
-    pub fn point(&self, x: f32) -> Vec2 {
-        let u = (x / self.width).clamp(-0.5, 0.5);
-        let z = 2f32.powf(1.6) * self.depth * ((0.5 + u) * (0.5 - u)).max(0.0).powf(0.8);
-        Vec2::new(x, self.front_z - self.depth + z)
-    }
-}
-
-/// An arch curve tabulated by arc length from the midline, for placing teeth.
-#[derive(Clone, Debug)]
-pub struct ArchCurve {
-    /// (arc length, point) along the left half, from the midline.
-    table: Vec<(f32, Vec2)>,
-}
-
-impl ArchCurve {
-    /// Tabulates a beta arch (x = W/2 · sin θ, dense where the curve turns backwards).
-    pub fn new(form: &BetaArch) -> Self {
-        const N: usize = 1500;
-        let mut table = Vec::with_capacity(N + 1);
-        let mut s = 0.0;
-        let mut prev = form.point(0.0);
-        for i in 0..=N {
-            let theta = std::f32::consts::FRAC_PI_2 * i as f32 / N as f32;
-            let p = form.point(0.5 * form.width * theta.sin());
-            s += p.distance(prev);
-            prev = p;
-            table.push((s, p));
-        }
-        Self { table }
-    }
-
-    /// Point and unit tangent (direction of increasing arc length: from the patient's right to
-    /// left) at signed arc length `s` (negative on the patient's right).
-    pub fn at(&self, s: f32) -> (Vec2, Vec2) {
-        let u = s.abs();
-        let (end_s, end_p) = *self.table.last().expect("tabulated curve");
-        let (p, dir) = if u >= end_s {
-            (end_p + Vec2::new(0.0, -(u - end_s)), Vec2::new(0.0, -1.0))
-        } else {
-            let i = self
-                .table
-                .partition_point(|e| e.0 < u)
-                .clamp(1, self.table.len() - 1);
-            let (s0, p0) = self.table[i - 1];
-            let (s1, p1) = self.table[i];
-            let f = if s1 > s0 { (u - s0) / (s1 - s0) } else { 0.0 };
-            (p0.lerp(p1, f), (p1 - p0).normalize_or(Vec2::X))
-        };
-        if s >= 0.0 {
-            (p, dir)
-        } else {
-            (Vec2::new(-p.x, p.y), Vec2::new(dir.x, -dir.y))
-        }
-    }
-}
+use bisect::{bisect_clamped, solve_increasing};
+pub use form::{ArchCurve, BetaArch};
+pub use occlusion::measure_occlusion;
 
 /// Parameters of the normal arrangement.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -226,51 +166,6 @@ fn pose_on_curve(
 /// Signed gap between two posed shapes (negative when they overlap).
 fn gap(a: &ToothGeometry, pa: &Pose, b: &ToothGeometry, pb: &Pose) -> f32 {
     mesh_separation(a.mesh_ref(), pa, b.mesh_ref(), pb).signed_gap()
-}
-
-/// Bisection for an increasing f bracketed by f(lo) < target <= f(hi): returns a point within
-/// 1e-5 of the crossing on the `hi` side, so f there is at least `target` (never closer than asked).
-fn bisect_bracketed(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, target: f32) -> f32 {
-    for _ in 0..40 {
-        if hi - lo < 1e-5 {
-            break;
-        }
-        let mid = 0.5 * (lo + hi);
-        if f(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    hi
-}
-
-/// Finds x with f(x) = target for an increasing f, widening [lo, hi] until it brackets the target.
-fn solve_increasing(mut f: impl FnMut(f32) -> f32, mut lo: f32, mut hi: f32, target: f32) -> f32 {
-    for _ in 0..20 {
-        if f(lo) <= target {
-            break;
-        }
-        lo -= hi - lo;
-    }
-    for _ in 0..20 {
-        if f(hi) >= target {
-            break;
-        }
-        hi += hi - lo;
-    }
-    bisect_bracketed(f, lo, hi, target)
-}
-
-/// Finds x in [lo, hi] where an increasing f crosses `target`, clamped to the ends.
-fn bisect_clamped(mut f: impl FnMut(f32) -> f32, lo: f32, hi: f32, target: f32) -> f32 {
-    if f(lo) >= target {
-        return lo;
-    }
-    if f(hi) <= target {
-        return hi;
-    }
-    bisect_bracketed(f, lo, hi, target)
 }
 
 /// Places one arch along its curve with adjacent crowns `contact_gap` apart.
@@ -506,91 +401,5 @@ pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arran
         upper: upper_form,
         upper_residual,
         measures,
-    }
-}
-
-/// Overjet, overbite and molar relation of an arrangement.
-pub fn measure_occlusion(shapes: &ShapeSet, poses: &[(Fdi, Pose)]) -> OcclusionMeasures {
-    let pose = |n: i64| {
-        let f = Fdi::new(n).expect("valid FDI");
-        (
-            shapes.get(f.arch(), f.kind()),
-            poses
-                .iter()
-                .find(|(g, _)| *g == f)
-                .map_or(Pose::IDENTITY, |x| x.1),
-        )
-    };
-    let mut overjet = 0.0;
-    let mut overbite = 0.0;
-    let mut molar = 0.0;
-    for (upper_incisor, lower_incisor, upper_molar, lower_molar) in
-        [(11, 41, 16, 46), (21, 31, 26, 36)]
-    {
-        let (su, pu) = pose(upper_incisor);
-        let (sl, pl) = pose(lower_incisor);
-        let edge = pu.transform_point(su.cusp_tips[0]);
-        let lower_edge = pl.transform_point(sl.cusp_tips[0]);
-        overbite += lower_edge.y - edge.y;
-        // The lower incisor's labial surface at the height of the upper edge.
-        let labial = sl
-            .mesh
-            .vertices
-            .iter()
-            .map(|&v| pl.transform_point(v))
-            .filter(|v| (v.y - edge.y).abs() < 1.0 && (v.x - edge.x).abs() < 2.0)
-            .map(|v| v.z)
-            .fold(f32::NEG_INFINITY, f32::max);
-        overjet += if labial.is_finite() {
-            edge.z - labial
-        } else {
-            f32::NAN
-        };
-        let (su, pu) = pose(upper_molar);
-        let (sl, pl) = pose(lower_molar);
-        let mesiobuccal = su
-            .cusp_tips
-            .iter()
-            .map(|&c| pu.transform_point(c))
-            .filter(|c| (*c - pu.translation).dot(pu.transform_vector(Vec3::Z)) > 0.0)
-            .max_by(|a, b| a.z.total_cmp(&b.z))
-            .unwrap_or(pu.translation);
-        let groove = pl.transform_point(Vec3::new(0.0, sl.frame.crown_length, 0.0));
-        molar += mesiobuccal.z - groove.z;
-    }
-    OcclusionMeasures {
-        overjet_mm: overjet / 2.0,
-        overbite_mm: overbite / 2.0,
-        molar_relation_mm: molar / 2.0,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_beta_curve_has_its_depth_and_width() {
-        let form = BetaArch {
-            width: 50.0,
-            depth: 36.0,
-            front_z: 18.0,
-        };
-        assert!((form.point(0.0).y - 18.0).abs() < 1e-2);
-        assert!((form.point(25.0).y - (18.0 - 36.0)).abs() < 1e-4);
-        let curve = ArchCurve::new(&form);
-        let (p, t) = curve.at(0.0);
-        assert!((p - Vec2::new(0.0, 18.0)).length() < 1e-2, "{p}");
-        assert!((t - Vec2::X).length() < 1e-2, "{t}");
-        let (l, tl) = curve.at(30.0);
-        let (r, tr) = curve.at(-30.0);
-        assert!(
-            (l.x + r.x).abs() < 1e-4 && (l.y - r.y).abs() < 1e-4,
-            "mirror symmetric"
-        );
-        assert!(tl.y < 0.0 && tr.y > 0.0);
-        // Past the end the curve runs straight back.
-        let (far, tf) = curve.at(200.0);
-        assert!((far.x - 25.0).abs() < 1e-3 && (tf - Vec2::new(0.0, -1.0)).length() < 1e-6);
     }
 }

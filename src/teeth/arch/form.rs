@@ -1,0 +1,103 @@
+//! The beta-function arch form (Braun et al. 1998) and its arc-length table.
+
+use glam::Vec2;
+use serde::Serialize;
+
+/// The beta-function arch form.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BetaArch {
+    /// Width `W` at the distal of the second molars (mm).
+    pub width: f32,
+    /// Depth `D` from the second molars' line to the front (mm).
+    pub depth: f32,
+    /// World z of the curve's front point.
+    pub front_z: f32,
+}
+
+impl BetaArch {
+    /// The point of the curve at lateral position `x` (|x| ≤ W/2), as (x, z).
+    pub fn point(&self, x: f32) -> Vec2 {
+        let u = (x / self.width).clamp(-0.5, 0.5);
+        let z = 2f32.powf(1.6) * self.depth * ((0.5 + u) * (0.5 - u)).max(0.0).powf(0.8);
+        Vec2::new(x, self.front_z - self.depth + z)
+    }
+}
+
+/// An arch curve tabulated by arc length from the midline, for placing teeth.
+#[derive(Clone, Debug)]
+pub struct ArchCurve {
+    /// (arc length, point) along the left half, from the midline.
+    table: Vec<(f32, Vec2)>,
+}
+
+impl ArchCurve {
+    /// Tabulates a beta arch (x = W/2 · sin θ, dense where the curve turns backwards).
+    pub fn new(form: &BetaArch) -> Self {
+        const N: usize = 1500;
+        let mut table = Vec::with_capacity(N + 1);
+        let mut s = 0.0;
+        let mut prev = form.point(0.0);
+        for i in 0..=N {
+            let theta = std::f32::consts::FRAC_PI_2 * i as f32 / N as f32;
+            let p = form.point(0.5 * form.width * theta.sin());
+            s += p.distance(prev);
+            prev = p;
+            table.push((s, p));
+        }
+        Self { table }
+    }
+
+    /// Point and unit tangent (direction of increasing arc length: from the patient's right to
+    /// left) at signed arc length `s` (negative on the patient's right).
+    pub fn at(&self, s: f32) -> (Vec2, Vec2) {
+        let u = s.abs();
+        let (end_s, end_p) = *self.table.last().expect("tabulated curve");
+        let (p, dir) = if u >= end_s {
+            (end_p + Vec2::new(0.0, -(u - end_s)), Vec2::new(0.0, -1.0))
+        } else {
+            let i = self
+                .table
+                .partition_point(|e| e.0 < u)
+                .clamp(1, self.table.len() - 1);
+            let (s0, p0) = self.table[i - 1];
+            let (s1, p1) = self.table[i];
+            let f = if s1 > s0 { (u - s0) / (s1 - s0) } else { 0.0 };
+            (p0.lerp(p1, f), (p1 - p0).normalize_or(Vec2::X))
+        };
+        if s >= 0.0 {
+            (p, dir)
+        } else {
+            (Vec2::new(-p.x, p.y), Vec2::new(dir.x, -dir.y))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_beta_curve_has_its_depth_and_width() {
+        let form = BetaArch {
+            width: 50.0,
+            depth: 36.0,
+            front_z: 18.0,
+        };
+        assert!((form.point(0.0).y - 18.0).abs() < 1e-2);
+        assert!((form.point(25.0).y - (18.0 - 36.0)).abs() < 1e-4);
+        let curve = ArchCurve::new(&form);
+        let (p, t) = curve.at(0.0);
+        assert!((p - Vec2::new(0.0, 18.0)).length() < 1e-2, "{p}");
+        assert!((t - Vec2::X).length() < 1e-2, "{t}");
+        let (l, tl) = curve.at(30.0);
+        let (r, tr) = curve.at(-30.0);
+        assert!(
+            (l.x + r.x).abs() < 1e-4 && (l.y - r.y).abs() < 1e-4,
+            "mirror symmetric"
+        );
+        assert!(tl.y < 0.0 && tr.y > 0.0);
+        // Past the end the curve runs straight back.
+        let (far, tf) = curve.at(200.0);
+        assert!((far.x - 25.0).abs() < 1e-3 && (tf - Vec2::new(0.0, -1.0)).length() < 1e-6);
+    }
+}
