@@ -3,8 +3,8 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::{octree::build_octree, tree::SphereTree};
-use crate::geometry::TriMesh;
+use super::{medial::build_medial, octree::build_octree, tree::SphereTree};
+use crate::geometry::{TriMesh, TriangleBvh};
 
 /// Which builder makes the tree.
 #[derive(
@@ -15,6 +15,8 @@ pub enum TreeMethod {
     /// Recursive subdivision of the bounding cube (Hubbard 1993); branching 8 only.
     #[default]
     Octree,
+    /// Spheres on the medial axis chosen by a weighted set cover (see [`super::medial`]).
+    Medial,
 }
 
 /// How sphere trees are built (RON-serialisable).
@@ -75,11 +77,12 @@ impl TreeSettings {
         }
     }
 
-    /// Builds the tree of `mesh` with these settings.
-    pub fn build(&self, mesh: &TriMesh) -> Result<SphereTree, TreeBuildError> {
+    /// Builds the tree of `mesh` (with its triangle hierarchy) with these settings.
+    pub fn build(&self, mesh: &TriMesh, bvh: &TriangleBvh) -> Result<SphereTree, TreeBuildError> {
         self.validate()?;
         Ok(match self.method {
             TreeMethod::Octree => build_octree(mesh, self.depth),
+            TreeMethod::Medial => build_medial(mesh, bvh, self.branching, self.depth),
         })
     }
 }

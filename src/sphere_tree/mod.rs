@@ -20,6 +20,7 @@
 
 pub mod build;
 pub mod coverage;
+pub mod medial;
 pub mod metrics;
 pub mod octree;
 pub mod plugin;

@@ -129,7 +129,8 @@ fn start_builds_and_attach(
             let geometry = shape.0.clone();
             let settings = settings.0;
             let job = geometry.clone();
-            let task = AsyncComputeTaskPool::get().spawn(async move { settings.build(&job.mesh) });
+            let task = AsyncComputeTaskPool::get()
+                .spawn(async move { settings.build(&job.mesh, &job.bvh) });
             store.pending.insert(k, (geometry, task));
         }
     }

@@ -90,7 +90,9 @@ pub fn trees_report(
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<ShapeResult> = crate::parallel::parallel_map(&shapes, |g| {
         let start = Instant::now();
-        let tree = settings.build(&g.mesh).expect("settings validated above");
+        let tree = settings
+            .build(&g.mesh, &g.bvh)
+            .expect("settings validated above");
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         let fit = tree_fit(&tree, g.mesh_ref(), g.frame.volume_mm3);
         progress(
