@@ -120,6 +120,15 @@ fn main() -> ExitCode {
     }
 }
 
+/// Prints one pretty JSON object on stdout.
+fn print_json(value: &impl serde::Serialize) -> Result<()> {
+    println!(
+        "{}",
+        serde_json::to_string_pretty(value).context("writing JSON")?
+    );
+    Ok(())
+}
+
 fn list_cases() {
     for name in Case::builtin_names() {
         let loaded = Case::resolve(name).expect("built-in cases are valid");
@@ -145,11 +154,7 @@ fn run_inspect(case: &str, json: bool, resolution: Option<u32>) -> Result<()> {
     }
     let report = inspect(&dentition);
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).context("writing JSON")?
-        );
-        return Ok(());
+        return print_json(&report);
     }
     println!(
         "case {} ({}), {} vertices per tooth",
@@ -229,11 +234,7 @@ fn run_trees(
         }
     }
     if json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).context("writing JSON")?
-        );
-        return Ok(());
+        return print_json(&report);
     }
     println!(
         "{:?} trees, branching {}, depth {} ({} teeth)",

@@ -87,6 +87,19 @@ impl Sphere {
     }
 }
 
+/// `n` unit directions spread evenly over the sphere (a Fibonacci lattice), deterministic.
+pub fn fibonacci_directions(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - y * y).max(0.0).sqrt();
+            let t = golden * i as f32;
+            Vec3::new(r * t.cos(), y, r * t.sin())
+        })
+        .collect()
+}
+
 fn sphere2(a: DVec3, b: DVec3) -> (DVec3, f64) {
     let c = (a + b) * 0.5;
     (c, a.distance(c))

@@ -97,19 +97,6 @@ fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
     Sphere::new(p - n * r, r)
 }
 
-/// Fibonacci-lattice directions.
-fn directions(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
-            let r = (1.0 - y * y).sqrt();
-            let t = golden * i as f32;
-            Vec3::new(r * t.cos(), y, r * t.sin())
-        })
-        .collect()
-}
-
 /// Builds a medial sphere tree with `levels` levels and branching `branching`.
 pub fn build_medial(
     mesh: &TriMesh,
@@ -135,7 +122,7 @@ pub fn build_medial(
         .iter()
         .map(|&(p, n)| medial_ball(m, p, n, start))
         .collect();
-    let probes = directions(SHELL_PROBES);
+    let probes = crate::geometry::sphere::fibonacci_directions(SHELL_PROBES);
     // Scale the growth to the leaf budget: about max_leaves spheres must cover the area.
     let mut spacing = 0.5 * (area / max_leaves as f32).sqrt();
     let mut leaves = Vec::new();

@@ -144,14 +144,9 @@ pub fn union_outside_volume(mesh: MeshRef, leaves: &[Sphere]) -> f64 {
 
 /// Largest distance from a point of the sphere's surface outside the mesh to the mesh.
 pub fn overhang(mesh: MeshRef, s: &Sphere) -> f32 {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..OVERHANG_SAMPLES)
-        .map(|i| {
-            let y = 1.0 - 2.0 * (i as f32 + 0.5) / OVERHANG_SAMPLES as f32;
-            let r = (1.0 - y * y).sqrt();
-            let th = golden * i as f32;
-            s.centre + Vec3::new(r * th.cos(), y, r * th.sin()) * s.radius
-        })
+    crate::geometry::sphere::fibonacci_directions(OVERHANG_SAMPLES as usize)
+        .into_iter()
+        .map(|d| s.centre + d * s.radius)
         .filter(|&p| outside(mesh, p))
         .filter_map(|p| closest_point_on_mesh(mesh, p).map(|(_, d)| d))
         .fold(0.0, f32::max)
