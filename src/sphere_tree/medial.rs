@@ -124,7 +124,7 @@ pub fn build_medial(
         .collect();
     let probes = crate::geometry::sphere::fibonacci_directions(SHELL_PROBES);
     // Scale the growth to the leaf budget: about max_leaves spheres must cover the area.
-    let mut spacing = 0.5 * (area / max_leaves as f32).sqrt();
+    let mut spacing = 0.42 * (area / max_leaves as f32).sqrt();
     let mut leaves = Vec::new();
     for _attempt in 0..6 {
         leaves = greedy_cover(m, &samples, &balls, &probes, spacing);
@@ -207,10 +207,21 @@ fn assign_pieces(
         let normal = (tb - ta).cross(tc - ta).normalize_or_zero();
         let mut stack = vec![(mesh.triangle(t), 0u32)];
         while let Some((piece, depth)) = stack.pop() {
-            if let Some(i) = leaves
+            // Of the leaves holding the piece, the one it lies deepest in (relative to its radius), so
+            // that leaves can shrink to their own pieces afterwards.
+            let holder = leaves
                 .iter()
-                .position(|s| piece.iter().all(|&p| s.contains(p)))
-            {
+                .enumerate()
+                .filter(|(_, s)| piece.iter().all(|&p| s.contains(p)))
+                .map(|(i, s)| {
+                    let reach = piece
+                        .iter()
+                        .map(|p| p.distance(s.centre))
+                        .fold(0.0f32, f32::max);
+                    (i, reach / s.radius)
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((i, _)) = holder {
                 out.push((i, piece));
                 continue;
             }
@@ -259,11 +270,25 @@ fn repair_and_group(
     }
     leaves.truncate(max_leaves);
     let pieces = assign_pieces(m, &mut leaves, max_leaves, spacing);
-    // Piece corners per leaf, for the inner spheres.
+    // Piece corners per leaf, for shrinking the leaves and for the inner spheres.
     let mut corners: Vec<Vec<Vec3>> = vec![Vec::new(); leaves.len()];
     for (i, p) in &pieces {
         corners[*i].extend_from_slice(p);
     }
+    // Each leaf shrinks to the pieces it is responsible for (they stay inside it); leaves left with
+    // none are dropped.
+    let (leaves, corners): (Vec<Sphere>, Vec<Vec<Vec3>>) = leaves
+        .into_iter()
+        .zip(corners)
+        .filter(|(_, c)| !c.is_empty())
+        .map(|(s, c)| {
+            let reach = c
+                .iter()
+                .map(|p| p.distance(s.centre))
+                .fold(0.0f32, f32::max);
+            (Sphere::new(s.centre, reach.next_up().min(s.radius)), c)
+        })
+        .unzip();
     let order: Vec<usize> = (0..leaves.len()).collect();
     place(tree, 0, 0, order, &leaves, &corners, mesh);
 }
