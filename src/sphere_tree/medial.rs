@@ -124,7 +124,7 @@ pub fn build_medial(
         .collect();
     let probes = crate::geometry::sphere::fibonacci_directions(SHELL_PROBES);
     // Scale the growth to the leaf budget: about max_leaves spheres must cover the area.
-    let mut spacing = 0.42 * (area / max_leaves as f32).sqrt();
+    let mut spacing = 0.36 * (area / max_leaves as f32).sqrt();
     let mut leaves = Vec::new();
     for _attempt in 0..6 {
         leaves = greedy_cover(m, &samples, &balls, &probes, spacing);
