@@ -88,12 +88,17 @@ fn validity(m: &TriMesh) -> Result<(), String> {
 
 /// Computes the report of a dentition.
 pub fn inspect(d: &Dentition) -> InspectReport {
+    // Teeth of one type share a mesh: validate each distinct mesh once.
+    let mut verdicts: std::collections::HashMap<usize, Result<(), String>> = Default::default();
     let teeth = d
         .teeth
         .iter()
         .map(|t| {
             let m = &t.geometry.mesh;
-            let valid = validity(m);
+            let valid = verdicts
+                .entry(std::sync::Arc::as_ptr(&t.geometry) as usize)
+                .or_insert_with(|| validity(m))
+                .clone();
             ToothReport {
                 fdi: t.fdi.number(),
                 kind: t.fdi.kind().name(),

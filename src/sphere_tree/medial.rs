@@ -17,7 +17,7 @@
 
 use glam::Vec3;
 
-use super::tree::SphereTree;
+use super::tree::{SphereTree, triangles_touching};
 use crate::geometry::{
     MeshRef, Sphere, TriMesh,
     mesh_distance::{closest_point_on_mesh, point_inside_mesh},
@@ -118,8 +118,10 @@ pub fn build_medial(
         })
         .sum();
     let start = mesh.aabb().extent().length();
+    // Candidates come from every second sample: enough medial balls, half the shrinking work.
     let balls: Vec<Sphere> = samples
         .iter()
+        .step_by(2)
         .map(|&(p, n)| medial_ball(m, p, n, start))
         .collect();
     let probes = crate::geometry::sphere::fibonacci_directions(SHELL_PROBES);
@@ -144,9 +146,9 @@ fn greedy_cover(
     probes: &[Vec3],
     spacing: f32,
 ) -> Vec<Sphere> {
-    // Candidates: every fourth medial ball, grown by each margin.
+    // Candidates: every medial ball, grown by each margin.
     let mut candidates: Vec<(Sphere, f32)> = Vec::new();
-    for ball in balls.iter().step_by(2) {
+    for ball in balls {
         for g in GROWTH {
             let s = Sphere::new(ball.centre, ball.radius + g * spacing);
             let outside = probes
@@ -309,7 +311,7 @@ fn place(
     if group.len() == 1 || level + 1 >= tree.levels {
         let i = group[0];
         tree.nodes[node] = Some(leaves[i]);
-        tree.triangles[node] = touching(mesh, &leaves[i]);
+        tree.triangles[node] = triangles_touching(mesh, &leaves[i]);
         return;
     }
     let points: Vec<Vec3> = group
@@ -351,40 +353,4 @@ fn split_balanced(group: &mut [usize], leaves: &[Sphere], b: usize) -> Vec<Vec<u
     let mut out = split_balanced(l, leaves, left_parts);
     out.extend(split_balanced(r, leaves, b - left_parts));
     out
-}
-
-fn touching(mesh: &TriMesh, s: &Sphere) -> Vec<u32> {
-    (0..mesh.triangles.len() as u32)
-        .filter(|&t| {
-            let [a, b, c] = mesh.triangle(t as usize);
-            s.contains(crate::geometry::closest_point_triangle(s.centre, a, b, c))
-        })
-        .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::{
-        geometry::{TriangleBvh, trimesh::tests::cuboid},
-        sphere_tree::{check_coverage, coverage::DEFAULT_SPLIT_DEPTH},
-    };
-
-    #[test]
-    fn medial_trees_cover_and_stay_within_the_budget() {
-        let mesh = cuboid(Vec3::ZERO, Vec3::new(6.0, 3.0, 2.0));
-        let bvh = TriangleBvh::build(&mesh);
-        for (branching, levels) in [(8, 3), (4, 4), (2, 5)] {
-            let tree = build_medial(&mesh, &bvh, branching, levels);
-            let c = check_coverage(&tree, &mesh, DEFAULT_SPLIT_DEPTH);
-            assert!(c.covered, "B{branching} L{levels}: {c:?}");
-            let budget = (branching as usize).pow(levels - 1);
-            assert!(tree.leaves().count() <= budget, "B{branching} L{levels}");
-            // Medial balls lie inside the box: no leaf centre outside it.
-            assert!(tree.leaves().all(|n| {
-                let c = tree.nodes[n].unwrap().centre;
-                c.cmpge(Vec3::splat(-1e-3)).all() && c.cmple(Vec3::new(6.0, 3.0, 2.0) + 1e-3).all()
-            }));
-        }
-    }
 }

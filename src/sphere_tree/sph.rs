@@ -11,8 +11,8 @@ use std::fmt::Write as _;
 use glam::Vec3;
 use thiserror::Error;
 
-use super::tree::SphereTree;
-use crate::geometry::{Sphere, TriMesh, closest_point_triangle};
+use super::tree::{SphereTree, triangles_touching};
+use crate::geometry::{Sphere, TriMesh};
 
 /// A `.sph` text that cannot be read.
 #[derive(Clone, Debug, Error, PartialEq, Eq)]
@@ -130,12 +130,7 @@ impl SphereTree {
         }
         for n in leaves {
             let Some(s) = self.nodes[n] else { continue };
-            self.triangles[n] = (0..mesh.triangles.len() as u32)
-                .filter(|&t| {
-                    let [a, b, c] = mesh.triangle(t as usize);
-                    s.contains(closest_point_triangle(s.centre, a, b, c))
-                })
-                .collect();
+            self.triangles[n] = triangles_touching(mesh, &s);
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `SphereTree`: the flat B-ary sphere hierarchy in Bradshaw's index layout.
 
-use crate::geometry::Sphere;
+use crate::geometry::{Sphere, TriMesh, closest_point_triangle};
 
 /// A sphere hierarchy over one mesh (local frame). Node n's children are n·B+1 … n·B+B.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,6 +81,17 @@ impl SphereTree {
         let end = self.level_start(level + 1).min(self.nodes.len());
         self.nodes[start..end].iter().flatten().copied()
     }
+}
+
+/// The triangles of `mesh` that touch sphere `s` (exact: the triangle's closest point to the centre
+/// lies in the sphere).
+pub fn triangles_touching(mesh: &TriMesh, s: &Sphere) -> Vec<u32> {
+    (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            let [a, b, c] = mesh.triangle(t as usize);
+            s.contains(closest_point_triangle(s.centre, a, b, c))
+        })
+        .collect()
 }
 
 #[cfg(test)]
