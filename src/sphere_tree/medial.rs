@@ -354,3 +354,30 @@ fn split_balanced(group: &mut [usize], leaves: &[Sphere], b: usize) -> Vec<Vec<u
     out.extend(split_balanced(r, leaves, b - left_parts));
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{
+        geometry::{TriangleBvh, trimesh::tests::cuboid},
+        sphere_tree::{check_coverage, coverage::DEFAULT_SPLIT_DEPTH},
+    };
+
+    #[test]
+    fn medial_trees_cover_and_stay_within_the_budget() {
+        let mesh = cuboid(Vec3::ZERO, Vec3::new(6.0, 3.0, 2.0));
+        let bvh = TriangleBvh::build(&mesh);
+        for (branching, levels) in [(8, 3), (4, 4), (2, 5)] {
+            let tree = build_medial(&mesh, &bvh, branching, levels);
+            let c = check_coverage(&tree, &mesh, DEFAULT_SPLIT_DEPTH);
+            assert!(c.covered, "B{branching} L{levels}: {c:?}");
+            let budget = (branching as usize).pow(levels - 1);
+            assert!(tree.leaves().count() <= budget, "B{branching} L{levels}");
+            // Medial balls lie inside the box: no leaf centre outside it.
+            assert!(tree.leaves().all(|n| {
+                let c = tree.nodes[n].unwrap().centre;
+                c.cmpge(Vec3::splat(-1e-3)).all() && c.cmple(Vec3::new(6.0, 3.0, 2.0) + 1e-3).all()
+            }));
+        }
+    }
+}
