@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use orthosim::{
     analysis::inspect,
     sphere_tree::{
-        TreeMethod, TreeSettings,
+        TreeCache, TreeMethod, TreeSettings,
         report::{trees_report, write_atomic},
     },
     teeth::{Case, Dentition},
@@ -68,6 +68,10 @@ enum Command {
         /// Write one Bradshaw .sph file per tooth into this folder.
         #[arg(long)]
         out: Option<std::path::PathBuf>,
+        /// Read trees from, and store new ones in, this cache folder (build_ms is then the time to
+        /// read and check a cached tree).
+        #[arg(long)]
+        cache: Option<std::path::PathBuf>,
     },
 }
 
@@ -91,6 +95,7 @@ fn main() -> ExitCode {
             branching,
             json,
             out,
+            cache,
         } => run_trees(
             &case,
             TreeSettings {
@@ -100,6 +105,7 @@ fn main() -> ExitCode {
             },
             json,
             out.as_deref(),
+            cache.map(TreeCache::new).as_ref(),
         ),
         Command::Cases => {
             list_cases();
@@ -206,6 +212,7 @@ fn run_trees(
     settings: TreeSettings,
     json: bool,
     out: Option<&std::path::Path>,
+    cache: Option<&TreeCache>,
 ) -> Result<()> {
     settings.validate()?;
     let dentition = Dentition::build(Case::resolve(case)?)?;
@@ -223,7 +230,7 @@ fn run_trees(
             }
         }
     };
-    let (report, trees) = trees_report(&dentition, settings, &bar)?;
+    let (report, trees) = trees_report(&dentition, settings, cache, &bar)?;
     if let Some(dir) = out {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("{}: cannot create folder", dir.display()))?;
@@ -285,6 +292,9 @@ fn view(case: &str, camera: orthosim::occlusion_view::CameraPreset) -> Result<()
         .add_plugins(OrthoSimPlugins.set(TeethModelPlugin {
             initial_case: Some(case.to_owned()),
         }))
+        .insert_resource(orthosim::sphere_tree::SphereTreeCache(
+            TreeCache::user_default(),
+        ))
         .add_plugins(OcclusionViewPlugin {
             initial_view: camera,
         })

@@ -7,6 +7,7 @@
 pub mod aabb;
 pub mod bvh;
 pub mod closest;
+pub mod columns;
 pub mod decimate;
 pub mod mass;
 pub mod mesh_distance;
@@ -20,6 +21,7 @@ pub use closest::{
     TrianglePair, closest_point_triangle, closest_points_segment_segment,
     closest_points_triangle_triangle, triangles_intersect,
 };
+pub use columns::Columns;
 pub use mass::MassProperties;
 pub use mesh_distance::{MeshRef, MeshSeparation, mesh_separation};
 pub use pose::Pose;

@@ -97,14 +97,20 @@ pub fn check_coverage(tree: &SphereTree, mesh: &TriMesh, max_depth: u32) -> Cove
                 });
                 return report;
             }
-            let [a, b, c] = piece;
-            let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
-            for sub in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+            for sub in split4(piece) {
                 stack.push((sub, depth + 1));
             }
         }
     }
     report
+}
+
+/// The four halves-of-edges pieces of a triangle piece. Builders that split triangles use this too,
+/// so that their pieces are bit-for-bit the ones the check visits.
+pub fn split4(piece: [Vec3; 3]) -> [[Vec3; 3]; 4] {
+    let [a, b, c] = piece;
+    let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
+    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
 }
 
 #[cfg(test)]

@@ -14,11 +14,13 @@
 //! every pair of their ancestors) overlaps, so a descent that prunes non-overlapping pairs has no
 //! false negatives against the exact mesh.
 //!
-//! Builders: [`octree`] (Hubbard 1993). Files: [`sph`] reads and writes Bradshaw's format. Fit:
-//! [`metrics`]. ECS: [`SphereTreePlugin`] builds trees in the background. Reports: [`report`] (the
-//! `orthosim trees` command).
+//! Builders: [`octree`] (Hubbard 1993) and [`medial`] (ours: medial-axis spheres chosen by a set
+//! cover of the outside volume). Files: [`sph`] reads and writes Bradshaw's format; [`cache`] keeps
+//! built trees on disk. Fit: [`metrics`]. ECS: [`SphereTreePlugin`] builds trees in the background.
+//! Reports: [`report`] (the `orthosim trees` command).
 
 pub mod build;
+pub mod cache;
 pub mod coverage;
 pub mod medial;
 pub mod metrics;
@@ -29,6 +31,9 @@ pub mod sph;
 pub mod tree;
 
 pub use build::{TreeMethod, TreeSettings};
+pub use cache::{TreeCache, TreeSource};
 pub use coverage::{Coverage, check_coverage};
-pub use plugin::{SphereTreePlugin, SphereTreeSettings, SphereTreeSystems, ToothSphereTree};
+pub use plugin::{
+    SphereTreeCache, SphereTreePlugin, SphereTreeSettings, SphereTreeSystems, ToothSphereTree,
+};
 pub use tree::SphereTree;

@@ -2,7 +2,9 @@
 //! it to every tooth with that shape.
 //!
 //! A tooth without a [`ToothSphereTree`] is not ready: collision systems must skip it rather than
-//! report a result. Changing [`SphereTreeSettings`] drops every tree and rebuilds.
+//! report a result. Changing [`SphereTreeSettings`] drops every tree and rebuilds. With a
+//! [`SphereTreeCache`] directory set (the viewer sets the user's cache directory), trees are read
+//! from and written to disk (see [`super::cache`]).
 
 use std::{collections::HashMap, sync::Arc};
 
@@ -13,6 +15,7 @@ use bevy::{
 
 use super::{
     build::{TreeBuildError, TreeSettings},
+    cache::TreeCache,
     tree::SphereTree,
 };
 use crate::teeth::{ToothGeometry, ToothShape};
@@ -20,6 +23,10 @@ use crate::teeth::{ToothGeometry, ToothShape};
 /// The settings trees are built with.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct SphereTreeSettings(pub TreeSettings);
+
+/// Where built trees are cached on disk; None (the default) builds every tree afresh.
+#[derive(Resource, Clone, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
+pub struct SphereTreeCache(pub Option<TreeCache>);
 
 /// A tooth's sphere tree (shared by teeth of the same shape).
 #[derive(Component, Clone, Debug, Deref)]
@@ -52,6 +59,7 @@ pub struct SphereTreePlugin;
 impl Plugin for SphereTreePlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<SphereTreeSettings>()
+            .init_resource::<SphereTreeCache>()
             .init_resource::<TreeStore>()
             .configure_sets(
                 Update,
@@ -116,6 +124,7 @@ fn start_builds_and_attach(
     mut commands: Commands,
     mut store: ResMut<TreeStore>,
     settings: Res<SphereTreeSettings>,
+    cache: Res<SphereTreeCache>,
     teeth: Query<(Entity, &ToothShape), Without<ToothSphereTree>>,
 ) {
     for (entity, shape) in &teeth {
@@ -129,8 +138,15 @@ fn start_builds_and_attach(
             let geometry = shape.0.clone();
             let settings = settings.0;
             let job = geometry.clone();
-            let task = AsyncComputeTaskPool::get()
-                .spawn(async move { settings.build(&job.mesh, &job.bvh) });
+            let cache = cache.0.clone();
+            let task = AsyncComputeTaskPool::get().spawn(async move {
+                match cache {
+                    Some(cache) => cache
+                        .load_or_build(&settings, &job.mesh, &job.bvh)
+                        .map(|(tree, _)| tree),
+                    None => settings.build(&job.mesh, &job.bvh),
+                }
+            });
             store.pending.insert(k, (geometry, task));
         }
     }

@@ -4,7 +4,12 @@ use std::{path::Path, time::Instant};
 
 use serde::Serialize;
 
-use super::{build::TreeSettings, metrics::tree_fit, tree::SphereTree};
+use super::{
+    build::TreeSettings,
+    cache::{TreeCache, TreeSource},
+    metrics::tree_fit,
+    tree::SphereTree,
+};
 use crate::teeth::Dentition;
 
 /// One tooth's line.
@@ -24,6 +29,8 @@ pub struct ToothTreeReport {
     pub covered: bool,
     /// Time to build this shape's tree (ms); teeth sharing a shape share the build.
     pub build_ms: f64,
+    /// The tree was read from the cache rather than built.
+    pub from_cache: bool,
 }
 
 /// Means and extremes over the teeth.
@@ -66,14 +73,16 @@ pub struct TreesReport {
 struct ShapeResult {
     tree: SphereTree,
     build_ms: f64,
+    from_cache: bool,
     fit: super::metrics::TreeFit,
 }
 
-/// Builds and measures the trees of a dentition's visible teeth (each distinct shape once, on all
-/// cores); `progress` is called with (done, total) as shapes finish.
+/// Builds (or reads from `cache`) and measures the trees of a dentition's visible teeth (each
+/// distinct shape once, on all cores); `progress` is called with (done, total) as shapes finish.
 pub fn trees_report(
     d: &Dentition,
     settings: TreeSettings,
+    cache: Option<&TreeCache>,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(TreesReport, Vec<(u8, SphereTree)>), super::build::TreeBuildError> {
     settings.validate()?;
@@ -90,9 +99,13 @@ pub fn trees_report(
     let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<ShapeResult> = crate::parallel::parallel_map(&shapes, |g| {
         let start = Instant::now();
-        let tree = settings
-            .build(&g.mesh, &g.bvh)
-            .expect("settings validated above");
+        let (tree, source) = match cache {
+            Some(cache) => cache.load_or_build(&settings, &g.mesh, &g.bvh),
+            None => settings
+                .build(&g.mesh, &g.bvh)
+                .map(|t| (t, TreeSource::Built)),
+        }
+        .expect("settings validated above");
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         let fit = tree_fit(&tree, g.mesh_ref(), g.frame.volume_mm3);
         progress(
@@ -102,6 +115,7 @@ pub fn trees_report(
         ShapeResult {
             tree,
             build_ms,
+            from_cache: source == TreeSource::Cached,
             fit,
         }
     });
@@ -124,6 +138,7 @@ pub fn trees_report(
                 max_overhang_mm: r.fit.max_overhang_mm,
                 covered: r.fit.covered,
                 build_ms: r.build_ms,
+                from_cache: r.from_cache,
             }
         })
         .collect();

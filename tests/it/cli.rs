@@ -208,3 +208,50 @@ fn trees_reports_covering_octrees_and_writes_sph_files() {
     assert!(String::from_utf8_lossy(&refused.stderr).contains("branching 8"));
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
+    let cache = std::env::temp_dir().join(format!("orthosim-tree-cache-{}", std::process::id()));
+    std::fs::remove_dir_all(&cache).ok();
+    let run = || {
+        let out = orthosim(&[
+            "trees",
+            "--method",
+            "medial",
+            "--depth",
+            "3",
+            "--json",
+            "--cache",
+            cache.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("one JSON object")
+    };
+    let first = run();
+    let s = &first["summary"];
+    assert_eq!(s["all_covered"], true);
+    // The octree at this depth has a mean near 3 (README table); the medial builder must stay far
+    // below it, and within the budget of 8² leaves.
+    let mean = s["sov_sum_mean"].as_f64().unwrap();
+    assert!(mean > 0.0 && mean < 0.5, "{s}");
+    let teeth = first["teeth"].as_array().unwrap();
+    assert!(teeth.iter().all(|t| t["leaves"].as_u64().unwrap() <= 64));
+    assert!(teeth.iter().all(|t| t["from_cache"] == false));
+    // 16 distinct shapes, one file each.
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 16);
+    let second = run();
+    let again = second["teeth"].as_array().unwrap();
+    assert!(again.iter().all(|t| t["from_cache"] == true));
+    for (a, b) in teeth.iter().zip(again) {
+        assert_eq!(
+            a["sov_sum"], b["sov_sum"],
+            "the cached tree is the built one"
+        );
+        assert_eq!(a["leaves"], b["leaves"]);
+    }
+    std::fs::remove_dir_all(&cache).ok();
+}
