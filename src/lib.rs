@@ -4,13 +4,15 @@
 //! two dental arches, extract teeth, apply loads through an archwire, and watch teeth move and
 //! touch, with exact contacts and distances.
 //!
-//! The engine-free core (`geometry`, the non-ECS parts of `teeth`, `analysis`) is plain Rust on
+//! The engine-free core (`geometry`, the non-ECS parts of `teeth`, `sphere_tree` and `collision`,
+//! `analysis`) is plain Rust on
 //! glam types. Each plugin is a thin ECS layer over it.
 //!
 //! | plugin | module | what it adds |
 //! |---|---|---|
 //! | [`teeth::TeethModelPlugin`] | [`teeth`] | patient cases, tooth entities with shared shapes |
 //! | [`sphere_tree::SphereTreePlugin`] | [`sphere_tree`] | sphere trees per tooth shape, built in the background |
+//! | [`collision::CollisionPlugin`] | [`collision`] | broad and narrow phases, contacts of moving teeth |
 //! | `OcclusionViewPlugin` (feature `viewer`) | `occlusion_view` | rendering, orbit camera |
 
 //!
@@ -18,6 +20,7 @@
 //! simulation runs the same with or without a window.
 
 pub mod analysis;
+pub mod collision;
 pub mod geometry;
 #[cfg(feature = "viewer")]
 pub mod occlusion_view;
@@ -33,6 +36,7 @@ use bevy::{app::PluginGroupBuilder, prelude::*};
 /// |---|---|
 /// | [`teeth::TeethModelPlugin`] | loads cases, spawns teeth |
 /// | [`sphere_tree::SphereTreePlugin`] | builds each tooth shape's sphere tree in the background |
+/// | [`collision::CollisionPlugin`] | finds the contacts of moving teeth each simulation step |
 ///
 /// Swap one out with `OrthoSimPlugins.build().disable::<…>()`.
 pub struct OrthoSimPlugins;
@@ -42,6 +46,7 @@ impl PluginGroup for OrthoSimPlugins {
         PluginGroupBuilder::start::<Self>()
             .add(teeth::TeethModelPlugin::default())
             .add(sphere_tree::SphereTreePlugin)
+            .add(collision::CollisionPlugin::default())
     }
 }
 

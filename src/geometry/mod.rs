@@ -9,6 +9,7 @@ pub mod bvh;
 pub mod closest;
 pub mod columns;
 pub mod decimate;
+pub mod interval;
 pub mod mass;
 pub mod mesh_distance;
 pub mod pose;

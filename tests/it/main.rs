@@ -1,6 +1,7 @@
 //! orthosim integration tests: one test binary (one link of Bevy), one module per topic.
 
 mod cli;
+mod collision;
 mod ecs;
 mod geometry_props;
 mod oracle;

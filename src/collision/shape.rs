@@ -1,0 +1,152 @@
+//! What a tooth brings to collision detection: its mesh, a compact copy of its sphere tree, and its
+//! bounding circle (the paper's coarse method).
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+use crate::{
+    geometry::{Pose, Sphere},
+    sphere_tree::SphereTree,
+    teeth::ToothGeometry,
+};
+
+/// A sphere tree without empty slots, children stored contiguously, for fast descent.
+#[derive(Clone, Debug)]
+pub struct CompactTree {
+    /// Node spheres (local frame); node 0 is the root.
+    pub spheres: Vec<Sphere>,
+    /// Distance of each node's centre from the local origin (for the rotation bound).
+    pub rho: Vec<f32>,
+    /// First child of each node.
+    pub first: Vec<u32>,
+    /// Number of children (0 for a leaf).
+    pub count: Vec<u32>,
+    /// Triangles each leaf touches (empty for inner nodes).
+    pub triangles: Vec<Vec<u32>>,
+}
+
+impl CompactTree {
+    /// Copies the used slots of `tree` in breadth-first order.
+    pub fn new(tree: &SphereTree) -> Self {
+        let mut out = Self {
+            spheres: Vec::new(),
+            rho: Vec::new(),
+            first: Vec::new(),
+            count: Vec::new(),
+            triangles: Vec::new(),
+        };
+        let Some(root) = tree.root() else {
+            return out;
+        };
+        // Breadth-first: node k of the queue is compact node k.
+        let mut queue = std::collections::VecDeque::from([0usize]);
+        let mut next = 1u32;
+        out.spheres.push(root);
+        while let Some(n) = queue.pop_front() {
+            let kids: Vec<usize> = tree
+                .children(n)
+                .filter(|&c| tree.nodes[c].is_some())
+                .collect();
+            out.first.push(next);
+            out.count.push(kids.len() as u32);
+            next += kids.len() as u32;
+            out.triangles.push(if kids.is_empty() {
+                tree.triangles[n].clone()
+            } else {
+                Vec::new()
+            });
+            for c in kids {
+                out.spheres.push(tree.nodes[c].expect("filtered above"));
+                queue.push_back(c);
+            }
+        }
+        out.rho = out.spheres.iter().map(|s| s.centre.length()).collect();
+        out
+    }
+
+    /// True when node `i` has no children.
+    #[inline]
+    pub fn is_leaf(&self, i: usize) -> bool {
+        self.count[i] == 0
+    }
+
+    /// Children of node `i`.
+    #[inline]
+    pub fn children(&self, i: usize) -> std::ops::Range<usize> {
+        let f = self.first[i] as usize;
+        f..f + self.count[i] as usize
+    }
+
+    /// True when the tree has no spheres (the tooth is not ready).
+    pub fn is_empty(&self) -> bool {
+        self.spheres.is_empty()
+    }
+}
+
+/// The paper's bounding circle in the horizontal (x–z) plane: centre as a point of the tooth (local
+/// frame, so it moves with the tooth) and radius. Computed at a reference pose; it bounds the
+/// tooth's projection exactly at that pose and approximately under tipping (the method is coarse
+/// by design).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    /// Centre, local frame.
+    pub centre: Vec3,
+    /// Radius (mm).
+    pub radius: f32,
+}
+
+impl Circle {
+    /// The smallest circle around the x–z projection of the mesh at `pose`.
+    pub fn of(geometry: &ToothGeometry, pose: &Pose) -> Self {
+        let pts: Vec<Vec3> = geometry
+            .mesh
+            .vertices
+            .iter()
+            .map(|&v| {
+                let w = pose.transform_point(v);
+                Vec3::new(w.x, 0.0, w.z)
+            })
+            .collect();
+        let s = Sphere::enclosing(&pts);
+        let centre_world = Vec3::new(s.centre.x, pose.translation.y, s.centre.z);
+        Self {
+            centre: pose.inverse().transform_point(centre_world),
+            radius: s.radius,
+        }
+    }
+
+    /// Centre in the x–z plane at a pose.
+    pub fn centre_at(&self, pose: &Pose) -> Vec2 {
+        let c = pose.transform_point(self.centre);
+        Vec2::new(c.x, c.z)
+    }
+}
+
+/// A tooth ready for collision queries: geometry, compact tree, circle.
+#[derive(Clone, Debug)]
+pub struct CollisionShape {
+    /// Mesh, triangle hierarchy and frame.
+    pub geometry: Arc<ToothGeometry>,
+    /// The sphere tree, compacted.
+    pub tree: Arc<CompactTree>,
+    /// Largest distance of a vertex from the local origin (bounds point speeds under rotation).
+    pub max_rho: f32,
+}
+
+impl CollisionShape {
+    /// A shape from a tooth's geometry and its sphere tree.
+    pub fn new(geometry: Arc<ToothGeometry>, tree: &SphereTree) -> Self {
+        let max_rho = geometry
+            .mesh
+            .vertices
+            .iter()
+            .map(|v| v.length())
+            .fold(0.0, f32::max);
+        Self {
+            geometry,
+            tree: Arc::new(CompactTree::new(tree)),
+            max_rho,
+        }
+    }
+}

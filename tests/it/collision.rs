@@ -1,0 +1,226 @@
+//! Collision detection against parry3d: seeded random motions of real tooth pairs near contact.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+use orthosim::{
+    collision::{Body, Circle, CollisionShape, Method, Motion, query},
+    geometry::{Pose, TriMesh},
+    sphere_tree::{TreeMethod, TreeSettings},
+    teeth::{Case, Dentition, Fdi},
+};
+use parry3d::{
+    math::{Pose as PPose, Rot3, Vector},
+    query as pq,
+    shape::TriMesh as PMesh,
+};
+
+fn v(p: Vec3) -> Vector {
+    let [x, y, z] = p.to_array();
+    Vector::new(x, y, z)
+}
+
+fn ppose(p: &Pose) -> PPose {
+    let [x, y, z, w] = p.rotation.to_array();
+    PPose::from_parts(v(p.translation), Rot3::from_xyzw(x, y, z, w))
+}
+
+fn pmesh(m: &TriMesh) -> PMesh {
+    PMesh::new(
+        m.vertices.iter().map(|&p| v(p)).collect(),
+        m.triangles.clone(),
+    )
+    .expect("valid mesh")
+}
+
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f32 / (1u64 << 53) as f32
+    }
+    fn vec(&mut self, scale: f32) -> Vec3 {
+        Vec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * 2.0 * scale
+    }
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let p = self.vec(1.0);
+            if p.length_squared() > 0.01 && p.length_squared() <= 1.0 {
+                return p.normalize();
+            }
+        }
+    }
+}
+
+struct TestTooth {
+    shape: CollisionShape,
+    circle: Circle,
+    rest: Pose,
+    parry: PMesh,
+}
+
+fn teeth(method: TreeMethod, depth: u32, pairs: &[(u8, u8)]) -> Vec<(TestTooth, TestTooth)> {
+    let d = Dentition::build(Case::resolve("normal").unwrap()).unwrap();
+    let settings = TreeSettings {
+        method,
+        branching: 8,
+        depth,
+    };
+    let make = |n: u8| {
+        let t = d
+            .teeth
+            .iter()
+            .find(|t| t.fdi == Fdi::new(n as i64).unwrap())
+            .unwrap();
+        let tree = settings.build(&t.geometry.mesh, &t.geometry.bvh).unwrap();
+        TestTooth {
+            shape: CollisionShape::new(Arc::clone(&t.geometry), &tree),
+            circle: Circle::of(&t.geometry, &t.pose),
+            rest: t.pose,
+            parry: pmesh(&t.geometry.mesh),
+        }
+    };
+    pairs.iter().map(|&(a, b)| (make(a), make(b))).collect()
+}
+
+/// A random step of `t` near its rest pose, heading roughly towards `target`: length 0.01–5 mm
+/// (log-uniform), rotation up to ±15°, sometimes none of either.
+fn random_motion(rng: &mut Rng, t: &TestTooth, target: Vec3) -> Motion {
+    let start = Pose::new(
+        (Quat::from_axis_angle(rng.unit(), rng.vec(2f32.to_radians()).x) * t.rest.rotation)
+            .normalize(),
+        t.rest.translation + rng.vec(0.3),
+    );
+    let kind = rng.next();
+    let length = (0.01f32.ln() + rng.next() * (5.0f32.ln() - 0.01f32.ln())).exp();
+    let dir = ((target - start.translation).normalize_or_zero() + rng.vec(0.6)).normalize_or_zero();
+    let travel = if kind < 0.1 { Vec3::ZERO } else { dir * length };
+    let angle = if kind > 0.9 {
+        0.0
+    } else {
+        rng.vec(15f32.to_radians()).x
+    };
+    Motion {
+        start,
+        end: Pose::new(
+            (Quat::from_axis_angle(rng.unit(), angle) * start.rotation).normalize(),
+            start.translation + travel,
+        ),
+    }
+}
+
+fn intersects(a: &TestTooth, pa: &Pose, b: &TestTooth, pb: &Pose) -> bool {
+    pq::intersection_test(&ppose(pa), &a.parry, &ppose(pb), &b.parry)
+        .unwrap()
+        .intersecting
+}
+
+#[derive(Default, Debug)]
+struct Tally {
+    configs: usize,
+    touching: usize,
+    false_negatives: [usize; 4],
+    late: usize,
+    gap_errors: usize,
+    max_gap_diff: f32,
+}
+
+fn run(pairs: &[(TestTooth, TestTooth)], configs: usize, seed: u64) -> Tally {
+    const SAMPLES: usize = 8;
+    let mut rng = Rng(seed);
+    let mut tally = Tally::default();
+    for k in 0..configs {
+        let (a, b) = &pairs[k % pairs.len()];
+        let ma = random_motion(&mut rng, a, b.rest.translation);
+        let mb = if rng.next() < 0.5 {
+            Motion::still(b.rest)
+        } else {
+            random_motion(&mut rng, b, a.rest.translation)
+        };
+        let (ba, bb) = (
+            Body {
+                shape: &a.shape,
+                circle: a.circle,
+                motion: ma,
+            },
+            Body {
+                shape: &b.shape,
+                circle: b.circle,
+                motion: mb,
+            },
+        );
+        // Oracle: the first sampled time at which the meshes intersect.
+        let first = (0..=SAMPLES)
+            .map(|s| s as f32 / SAMPLES as f32)
+            .find(|&t| intersects(a, &ma.at(t), b, &mb.at(t)));
+        let at_end = intersects(a, &ma.end, b, &mb.end);
+        tally.configs += 1;
+        let results: Vec<_> = Method::ALL.iter().map(|&m| query(m, &ba, &bb)).collect();
+        if first.is_some() {
+            tally.touching += 1;
+        }
+        if at_end && results[1].is_none() {
+            tally.false_negatives[1] += 1;
+        }
+        for (i, r) in results.iter().enumerate().skip(2) {
+            if let Some(t) = first {
+                match r {
+                    None => tally.false_negatives[i] += 1,
+                    Some(c) if c.time_of_contact > t + 1e-6 => tally.late += 1,
+                    _ => {}
+                }
+            }
+        }
+        // The exact stage's gap against parry's distance at the reported time.
+        if let Some(c) = &results[3]
+            && c.time_of_contact > 0.0
+        {
+            let (pa, pb) = (ma.at(c.time_of_contact), mb.at(c.time_of_contact));
+            let d = pq::distance(&ppose(&pa), &a.parry, &ppose(&pb), &b.parry)
+                .unwrap()
+                .distance;
+            let diff = (d - (-c.depth_mm)).abs();
+            tally.max_gap_diff = tally.max_gap_diff.max(diff);
+            if diff > 2e-3 || d > 0.01 + 2e-3 || intersects(a, &pa, b, &pb) {
+                tally.gap_errors += 1;
+            }
+        }
+    }
+    tally
+}
+
+const PAIRS: [(u8, u8); 8] = [
+    (11, 21),
+    (11, 12),
+    (13, 14),
+    (16, 17),
+    (26, 36),
+    (16, 46),
+    (31, 41),
+    (34, 35),
+];
+
+#[test]
+fn no_false_negatives_against_parry_on_ten_thousand_motions() {
+    let pairs = teeth(TreeMethod::Octree, 4, &PAIRS);
+    let t = run(&pairs, 10_000, 0x0c0f_fee5_eed5);
+    eprintln!("{t:?}");
+    assert!(t.touching > 1000, "the set must exercise contact: {t:?}");
+    assert_eq!(t.false_negatives, [0; 4], "{t:?}");
+    assert_eq!(t.late, 0, "{t:?}");
+    assert_eq!(t.gap_errors, 0, "{t:?}");
+}
+
+#[test]
+fn medial_trees_keep_the_guarantees() {
+    let pairs = teeth(TreeMethod::Medial, 3, &PAIRS[..3]);
+    let t = run(&pairs, 600, 0x51de_5eed);
+    eprintln!("{t:?}");
+    assert!(t.touching > 50, "{t:?}");
+    assert_eq!(t.false_negatives, [0; 4], "{t:?}");
+    assert_eq!(t.late, 0, "{t:?}");
+    assert_eq!(t.gap_errors, 0, "{t:?}");
+}
