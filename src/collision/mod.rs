@@ -5,6 +5,7 @@
 //! opposing teeth whose swept root spheres can meet) and [`narrow_phase`] (circles, spheres,
 //! continuous and exact, with their guarantees). ECS layer: [`plugin::CollisionPlugin`].
 
+pub mod bench;
 pub mod broad_phase;
 pub mod motion;
 pub mod narrow_phase;

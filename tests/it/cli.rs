@@ -255,3 +255,50 @@ fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
     }
     std::fs::remove_dir_all(&cache).ok();
 }
+
+#[test]
+fn bench_reports_every_method_with_no_false_negatives() {
+    let out = orthosim(&[
+        "bench",
+        "--pairs",
+        "60",
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["pairs"], 60);
+    assert!(v["full_mouth_step_us"].as_f64().unwrap() > 0.0);
+    let methods = v["methods"].as_array().unwrap();
+    let names: Vec<&str> = methods
+        .iter()
+        .map(|m| m["method"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["circles", "spheres", "continuous", "exact"]);
+    for m in methods {
+        for key in [
+            "us_per_pair",
+            "false_negatives",
+            "false_positives",
+            "mean_error_mm",
+            "max_error_mm",
+        ] {
+            assert!(m.get(key).is_some(), "missing {key} in {m}");
+        }
+        if m["method"] != "circles" {
+            assert_eq!(m["false_negatives"], 0, "{m}");
+        }
+    }
+    let exact = &methods[3];
+    assert_eq!(exact["false_positives"], 0);
+    assert!(
+        exact["max_error_mm"].as_f64().unwrap() <= 0.01 + 1e-6,
+        "{exact}"
+    );
+}

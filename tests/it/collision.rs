@@ -224,3 +224,146 @@ fn medial_trees_keep_the_guarantees() {
     assert_eq!(t.late, 0, "{t:?}");
     assert_eq!(t.gap_errors, 0, "{t:?}");
 }
+
+/// Checks the continuous and exact methods against parry sampled at 256 times: no miss, never late.
+fn check_against_samples(a: &TestTooth, ma: Motion, b: &TestTooth, mb: Motion) -> Option<f32> {
+    let ba = Body {
+        shape: &a.shape,
+        circle: a.circle,
+        motion: ma,
+    };
+    let bb = Body {
+        shape: &b.shape,
+        circle: b.circle,
+        motion: mb,
+    };
+    let first = (0..=256)
+        .map(|s| s as f32 / 256.0)
+        .find(|&t| intersects(a, &ma.at(t), b, &mb.at(t)));
+    for m in [Method::Continuous, Method::Exact] {
+        let r = query(m, &ba, &bb);
+        if let Some(t) = first {
+            let c = r.unwrap_or_else(|| panic!("{m:?} missed a contact at t = {t}"));
+            assert!(c.time_of_contact <= t + 1e-6, "{m:?} late: {c:?} vs {t}");
+        }
+    }
+    query(Method::Exact, &ba, &bb).map(|c| c.time_of_contact)
+}
+
+#[test]
+fn adversarial_motions() {
+    let pairs = teeth(TreeMethod::Octree, 4, &[(11, 21), (16, 46)]);
+    let (a, b) = &pairs[0];
+    let towards = (b.rest.translation - a.rest.translation).normalize();
+    let shift = |p: Pose, d: Vec3| Pose::new(p.rotation, p.translation + d);
+    fn body(t: &TestTooth, m: Motion) -> Body<'_> {
+        Body {
+            shape: &t.shape,
+            circle: t.circle,
+            motion: m,
+        }
+    }
+    // Zero relative motion: both move together 2 mm; 0.05 mm apart throughout, never touch.
+    let d = Vec3::new(0.3, -2.0, 1.0);
+    let (ma, mb) = (
+        Motion {
+            start: a.rest,
+            end: shift(a.rest, d),
+        },
+        Motion {
+            start: b.rest,
+            end: shift(b.rest, d),
+        },
+    );
+    // (The leaf spheres stick out more than 0.05 mm, so the sphere methods report their overlap.)
+    assert!(query(Method::Exact, &body(a, ma), &body(b, mb)).is_none());
+    // Identical poses: a tooth against itself overlaps from the start.
+    for m in Method::ALL {
+        let c = query(
+            m,
+            &body(a, Motion::still(a.rest)),
+            &body(a, Motion::still(a.rest)),
+        )
+        .unwrap_or_else(|| panic!("{m:?}"));
+        if m != Method::Circles && m != Method::Spheres {
+            assert_eq!(c.time_of_contact, 0.0, "{m:?}");
+        }
+    }
+    // Pure rotation by 15° about the vertical and about the mesiodistal direction.
+    for axis in [Vec3::Y, towards.cross(Vec3::Y).normalize()] {
+        let m = Motion {
+            start: a.rest,
+            end: Pose::new(
+                Quat::from_axis_angle(axis, 15f32.to_radians()) * a.rest.rotation,
+                a.rest.translation,
+            ),
+        };
+        check_against_samples(a, m, b, Motion::still(b.rest));
+    }
+    // Grazing: sliding past the neighbour, parallel to the contact.
+    let tangent = towards.cross(Vec3::Y).normalize();
+    check_against_samples(
+        a,
+        Motion {
+            start: a.rest,
+            end: shift(a.rest, tangent * 3.0),
+        },
+        b,
+        Motion::still(b.rest),
+    );
+    // Tiny and huge steps towards the neighbour; the huge one (100 mm) would tunnel through it.
+    let tiny = check_against_samples(
+        a,
+        Motion {
+            start: a.rest,
+            end: shift(a.rest, towards * 1e-6),
+        },
+        b,
+        Motion::still(b.rest),
+    );
+    assert!(tiny.is_none(), "a micrometre does not close 0.05 mm");
+    let huge = Motion {
+        start: a.rest,
+        end: shift(a.rest, towards * 100.0),
+    };
+    let t = check_against_samples(a, huge, b, Motion::still(b.rest)).expect("tunnelling caught");
+    assert!(t < 0.01, "{t}");
+    // Far from the origin: the same head-on motion 10⁴ mm away gives the same time.
+    let far = Vec3::new(1e4, 0.0, 1e4);
+    let step = |p: Pose| Motion {
+        start: p,
+        end: shift(p, towards * 0.5),
+    };
+    let near_t = query(
+        Method::Exact,
+        &body(a, step(a.rest)),
+        &body(b, Motion::still(b.rest)),
+    )
+    .expect("contact")
+    .time_of_contact;
+    let far_t = query(
+        Method::Exact,
+        &body(a, step(shift(a.rest, far))),
+        &body(b, Motion::still(shift(b.rest, far))),
+    )
+    .expect("contact far away")
+    .time_of_contact;
+    assert!((near_t - far_t).abs() < 0.01, "{near_t} vs {far_t}");
+    // Occluding teeth: the upper first molar closing 2.5 mm onto the lower one (their cusps stand
+    // about 1.3 mm apart at rest; class I puts the contacts on the neighbours).
+    let (u, l) = &pairs[1];
+    let gap = pq::distance(&ppose(&u.rest), &u.parry, &ppose(&l.rest), &l.parry)
+        .unwrap()
+        .distance;
+    assert!(gap > 0.0 && gap < 2.0, "{gap}");
+    check_against_samples(
+        u,
+        Motion {
+            start: u.rest,
+            end: shift(u.rest, Vec3::new(0.0, -2.5, 0.0)),
+        },
+        l,
+        Motion::still(l.rest),
+    )
+    .expect("the molars meet");
+}

@@ -196,3 +196,92 @@ fn every_tooth_gets_a_covering_sphere_tree() {
     }
     assert_eq!(distinct.len(), 16, "mirrored teeth share one tree");
 }
+
+#[derive(Resource, Default)]
+struct Started(Vec<(Entity, Entity)>);
+
+#[test]
+fn a_moving_tooth_reports_contacts_and_nothing_runs_when_nothing_moves() {
+    use orthosim::{
+        collision::{ContactStarted, Contacts, Motion, ToothCollider, ToothContact, ToothMotion},
+        geometry::Pose,
+    };
+    let mut app = create_app();
+    app.init_resource::<Started>().add_observer(
+        |ev: On<ContactStarted>, mut started: ResMut<Started>| {
+            started.0.push((ev.entity, ev.other));
+        },
+    );
+    load(&mut app, "normal").unwrap();
+    let mut ready = 0;
+    for _ in 0..3000 {
+        app.update();
+        let mut q = app
+            .world_mut()
+            .query_filtered::<(), (With<Tooth>, With<ToothCollider>)>();
+        ready = q.iter(app.world()).count();
+        if ready == 32 {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(
+        ready, 32,
+        "every tooth gets a collider once its tree is built"
+    );
+    // Nothing moves: no pair is tested.
+    for _ in 0..5 {
+        app.update();
+    }
+    assert_eq!(app.world().resource::<Contacts>().pairs_tested, 0);
+    assert!(app.world().resource::<Contacts>().list.is_empty());
+    // Tooth 11 moves 0.5 mm towards 21 (0.05 mm away): they must touch during the step.
+    let mut q = app.world_mut().query::<(Entity, &Tooth, &Transform)>();
+    let find = |n: u8, world: &World, q: &mut QueryState<(Entity, &Tooth, &Transform)>| {
+        q.iter(world)
+            .find(|(_, t, _)| t.id.number() == n)
+            .map(|(e, _, t)| (e, *t))
+            .unwrap()
+    };
+    let (e11, t11) = find(11, app.world(), &mut q);
+    let (e21, t21) = find(21, app.world(), &mut q);
+    let start = Pose::new(t11.rotation, t11.translation);
+    let towards = (t21.translation - t11.translation).normalize();
+    let motion = Motion {
+        start,
+        end: Pose::new(start.rotation, start.translation + towards * 0.5),
+    };
+    app.world_mut().entity_mut(e11).insert(ToothMotion(motion));
+    let mut cursor = app
+        .world()
+        .resource::<Messages<ToothContact>>()
+        .get_cursor_current();
+    for _ in 0..3 {
+        app.update();
+    }
+    let contacts = app.world().resource::<Contacts>();
+    assert!(contacts.pairs_tested >= 2, "11 has at least two neighbours");
+    let hit = contacts
+        .list
+        .iter()
+        .find(|c| (c.a == e11 && c.b == e21) || (c.a == e21 && c.b == e11))
+        .expect("11 and 21 touch");
+    assert!(hit.time_of_contact < 0.5, "{hit:?}");
+    let messages = cursor
+        .read(app.world().resource::<Messages<ToothContact>>())
+        .count();
+    assert!(
+        messages >= 3,
+        "one message per contact per step: {messages}"
+    );
+    // The pair started touching once, though the contact persists over the steps.
+    let started = &app.world().resource::<Started>().0;
+    assert_eq!(
+        started
+            .iter()
+            .filter(|p| **p == (e11, e21) || **p == (e21, e11))
+            .count(),
+        1,
+        "{started:?}"
+    );
+}
