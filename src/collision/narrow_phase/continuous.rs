@@ -37,10 +37,11 @@ pub struct SweptContact {
 /// False only when the relative centre A + B·t stays farther than `r` for every t in [0, 1].
 #[inline]
 pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
-    let unit = Interval::new(0.0, 1.0);
+    // Each component of A + B·t over t ∈ [0, 1] spans [A, A + B] (linear), the end rounded outward.
     let mut lo = Interval::point(0.0);
     for k in 0..3 {
-        let x = Interval::point(a[k]).add(Interval::point(b[k]).mul(unit));
+        let end = Interval::point(a[k]).add(Interval::point(b[k]));
+        let x = Interval::new(a[k].min(end.lo), a[k].max(end.hi));
         lo = lo.add(x.sqr());
     }
     let rr = Interval::point(r).sqr().hi;
@@ -79,8 +80,16 @@ pub fn first_contact(a: DVec3, b: DVec3, r: f64) -> Option<f64> {
     (t < 1.0).then_some(t)
 }
 
-/// Calls `leaf(i, j, t)` for every leaf pair whose swept (inflated) spheres meet during the step.
-pub fn swept_leaves(a: &Body, b: &Body, mut leaf: impl FnMut(usize, usize, f64)) {
+/// Calls `leaf(i, j, t)` for every leaf pair whose swept (inflated) spheres meet during the step;
+/// with `earliest_only`, node pairs that cannot meet before the earliest leaf time found so far are
+/// skipped (the earliest time is still exact; later pairs may be left out).
+pub fn swept_leaves(
+    a: &Body,
+    b: &Body,
+    earliest_only: bool,
+    mut leaf: impl FnMut(usize, usize, f64),
+) {
+    let mut best = f64::INFINITY;
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let (a0, a1) = (
         DPose::from_pose(&a.motion.start),
@@ -100,13 +109,21 @@ pub fn swept_leaves(a: &Body, b: &Body, mut leaf: impl FnMut(usize, usize, f64))
         + b.shape.max_rho as f64
         + 100.0;
     let slack = 1e-13 * scale + 1e-9;
+    // Each node's start and end centre, computed once per query.
+    let mut cache_a: Vec<Option<[DVec3; 2]>> = vec![None; ta.spheres.len()];
+    let mut cache_b: Vec<Option<[DVec3; 2]>> = vec![None; tb.spheres.len()];
+    let ends = |cache: &mut Vec<Option<[DVec3; 2]>>, p0: &DPose, p1: &DPose, c, n: usize| {
+        *cache[n].get_or_insert_with(|| [p0.apply(c), p1.apply(c)])
+    };
     let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
     stack.push((0, 0));
     while let Some((i, j)) = stack.pop() {
         let (i, j) = (i as usize, j as usize);
         let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let start = a0.apply(sa.centre) - b0.apply(sb.centre);
-        let end = a1.apply(sa.centre) - b1.apply(sb.centre);
+        let [ca0, ca1] = ends(&mut cache_a, &a0, &a1, sa.centre, i);
+        let [cb0, cb1] = ends(&mut cache_b, &b0, &b1, sb.centre, j);
+        let start = ca0 - cb0;
+        let end = ca1 - cb1;
         let r = sa.radius as f64
             + sb.radius as f64
             + ka * ta.rho[i] as f64
@@ -116,11 +133,17 @@ pub fn swept_leaves(a: &Body, b: &Body, mut leaf: impl FnMut(usize, usize, f64))
         if !may_meet(start, change, r) {
             continue;
         }
+        // The node spheres' own first time bounds their descendants' from below.
+        let Some(t) = first_contact(start, change, r) else {
+            continue;
+        };
+        if earliest_only && t > best {
+            continue;
+        }
         let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
         if la && lb {
-            if let Some(t) = first_contact(start, change, r) {
-                leaf(i, j, t);
-            }
+            best = best.min(t);
+            leaf(i, j, t);
         } else if !la && (lb || sa.radius >= sb.radius) {
             stack.extend(ta.children(i).map(|c| (c as u32, j as u32)));
         } else {
@@ -129,10 +152,13 @@ pub fn swept_leaves(a: &Body, b: &Body, mut leaf: impl FnMut(usize, usize, f64))
     }
 }
 
-/// The continuous query.
-pub fn query(a: &Body, b: &Body) -> Option<SweptContact> {
+/// The continuous query; with `all_pairs` every meeting leaf pair is listed (the exact stage needs
+/// them), else only those found on the way to the earliest time.
+pub fn query(a: &Body, b: &Body, all_pairs: bool) -> Option<SweptContact> {
     let mut leaf_times = Vec::new();
-    swept_leaves(a, b, |i, j, t| leaf_times.push((i as u32, j as u32, t)));
+    swept_leaves(a, b, !all_pairs, |i, j, t| {
+        leaf_times.push((i as u32, j as u32, t))
+    });
     let &(i, j, t) = leaf_times
         .iter()
         .min_by(|x, y| x.2.total_cmp(&y.2).then((x.0, x.1).cmp(&(y.0, y.1))))?;

@@ -6,8 +6,11 @@
 //! at the contact time; so every pair of triangles that can touch during the step is a candidate
 //! pair, and no other pair touches at all.
 //!
-//! Advancement: from the earliest leaf time (no contact can happen before it), the exact minimum
-//! distance d over the candidate pairs is computed at the current poses; no point of the candidates
+//! Advancement: from the earliest leaf time (no contact can happen before it), a lower bound d on
+//! the distance between the contact-capable parts (the surface inside each meeting leaf pair) is
+//! computed at the current poses: the exact distance between candidate triangles, visiting leaf
+//! pairs nearest first and skipping a leaf pair once its spheres are farther apart than the best
+//! distance so far (its in-sphere surface cannot be closer); no point of the candidates
 //! moves faster than μ = Σ (origin travel + rotation angle × farthest candidate vertex from the
 //! origin) per unit time ([`Motion::speed_bound`]), so the gap cannot close before t + d/μ. Each
 //! step advances by (d − tolerance/2)/μ, leaving at least half the tolerance, and stops when
@@ -28,32 +31,51 @@ pub const GAP_TOLERANCE_MM: f32 = 0.01;
 /// Most advancement steps per query.
 pub const MAX_STEPS: u32 = 1000;
 
-/// Triangles of one side in world coordinates, with bounding spheres for culling.
-struct Placed {
+/// A meeting leaf pair (nodes of a and b) with its candidate triangle pairs.
+type LeafPair = (u32, u32, Vec<(u32, u32)>);
+
+/// Triangles of one side placed at the current time, on demand.
+struct Placed<'m> {
+    mesh: &'m crate::geometry::TriMesh,
+    ids: Vec<u32>,
     tris: Vec<[Vec3; 3]>,
     bound: Vec<(Vec3, f32)>,
+    stamp: Vec<u32>,
+    now: u32,
 }
 
-fn place(
-    mesh: &crate::geometry::TriMesh,
-    ids: &[u32],
-    pose: &crate::geometry::Pose,
-    out: &mut Placed,
-) {
-    out.tris.clear();
-    out.bound.clear();
-    for &t in ids {
-        let tri = mesh.triangle(t as usize).map(|v| pose.transform_point(v));
-        let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-        let r = tri.iter().map(|v| v.distance(c)).fold(0.0f32, f32::max);
-        out.tris.push(tri);
-        out.bound.push((c, r));
+impl<'m> Placed<'m> {
+    fn new(mesh: &'m crate::geometry::TriMesh, ids: Vec<u32>) -> Self {
+        let n = ids.len();
+        Self {
+            mesh,
+            ids,
+            tris: vec![[Vec3::ZERO; 3]; n],
+            bound: vec![(Vec3::ZERO, 0.0); n],
+            stamp: vec![0; n],
+            now: 0,
+        }
+    }
+
+    fn get(&mut self, k: usize, pose: &crate::geometry::Pose) -> (&[Vec3; 3], (Vec3, f32)) {
+        if self.stamp[k] != self.now {
+            let tri = self
+                .mesh
+                .triangle(self.ids[k] as usize)
+                .map(|v| pose.transform_point(v));
+            let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+            let r = tri.iter().map(|v| v.distance(c)).fold(0.0f32, f32::max);
+            self.tris[k] = tri;
+            self.bound[k] = (c, r);
+            self.stamp[k] = self.now;
+        }
+        (&self.tris[k], self.bound[k])
     }
 }
 
 /// The exact query.
 pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
-    let swept = continuous::query(a, b)?;
+    let swept = continuous::query(a, b, true)?;
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     // Candidate triangles of each side and candidate pairs (as indices into them).
     let mut ids_a: Vec<u32> = Vec::new();
@@ -66,17 +88,21 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
     ids_a.dedup();
     ids_b.sort_unstable();
     ids_b.dedup();
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    for &(i, j, _) in &swept.leaf_times {
-        for &x in &ta.triangles[i as usize] {
-            let xi = ids_a.binary_search(&x).expect("collected above") as u32;
-            for &y in &tb.triangles[j as usize] {
-                pairs.push((xi, ids_b.binary_search(&y).expect("collected above") as u32));
+    // Per leaf pair, its triangle pairs (indices into ids_a / ids_b).
+    let leaf_pairs: Vec<LeafPair> = swept
+        .leaf_times
+        .iter()
+        .map(|&(i, j, _)| {
+            let mut tp = Vec::new();
+            for &x in &ta.triangles[i as usize] {
+                let xi = ids_a.binary_search(&x).expect("collected above") as u32;
+                for &y in &tb.triangles[j as usize] {
+                    tp.push((xi, ids_b.binary_search(&y).expect("collected above") as u32));
+                }
             }
-        }
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
+            (i, j, tp)
+        })
+        .collect();
     let (ma, mb) = (&a.shape.geometry.mesh, &b.shape.geometry.mesh);
     let rho = |mesh: &crate::geometry::TriMesh, ids: &[u32]| {
         ids.iter()
@@ -92,30 +118,52 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
         .iter()
         .map(|x| x.2)
         .fold(f64::INFINITY, f64::min);
-    let (mut pa, mut pb) = (
-        Placed {
-            tris: Vec::new(),
-            bound: Vec::new(),
-        },
-        Placed {
-            tris: Vec::new(),
-            bound: Vec::new(),
-        },
-    );
+    let mut pa = Placed::new(ma, ids_a);
+    let mut pb = Placed::new(mb, ids_b);
+    let mut order: Vec<(f32, usize)> = Vec::with_capacity(leaf_pairs.len());
+    // Triangle pairs already measured in this step (leaf pairs share triangles).
+    let ny = pb.ids.len();
+    let mut seen = vec![0u32; pa.ids.len() * ny];
+    let mut step = 0u32;
     for _ in 0..MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
-        place(ma, &ids_a, &pose_a, &mut pa);
-        place(mb, &ids_b, &pose_b, &mut pb);
+        pa.now += 1;
+        pb.now += 1;
+        // Leaf pairs nearest first: a pair whose spheres are farther apart than the best distance
+        // found cannot hold a closer contact-capable pair (see the module doc).
+        order.clear();
+        for (k, (i, j, _)) in leaf_pairs.iter().enumerate() {
+            let (sa, sb) = (ta.spheres[*i as usize], tb.spheres[*j as usize]);
+            let gap = pose_a
+                .transform_point(sa.centre)
+                .distance(pose_b.transform_point(sb.centre))
+                - sa.radius
+                - sb.radius;
+            order.push((gap, k));
+        }
+        order.sort_by(|x, y| x.0.total_cmp(&y.0));
+        step += 1;
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
-        for &(x, y) in &pairs {
-            let (cx, rx) = pa.bound[x as usize];
-            let (cy, ry) = pb.bound[y as usize];
-            if cx.distance(cy) - rx - ry >= best.0 {
-                continue;
+        for &(gap, k) in &order {
+            if gap >= best.0 {
+                break;
             }
-            let p = closest_points_triangle_triangle(&pa.tris[x as usize], &pb.tris[y as usize]);
-            if p.distance < best.0 {
-                best = (p.distance, p.on_first, p.on_second);
+            for &(x, y) in &leaf_pairs[k].2 {
+                let key = x as usize * ny + y as usize;
+                if seen[key] == step {
+                    continue;
+                }
+                seen[key] = step;
+                let (tx, (cx, rx)) = pa.get(x as usize, &pose_a);
+                let tx = *tx;
+                let (ty, (cy, ry)) = pb.get(y as usize, &pose_b);
+                if cx.distance(cy) - rx - ry >= best.0 {
+                    continue;
+                }
+                let p = closest_points_triangle_triangle(&tx, ty);
+                if p.distance < best.0 {
+                    best = (p.distance, p.on_first, p.on_second);
+                }
             }
         }
         let (d, qa, qb) = best;
@@ -162,12 +210,19 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
         }
     }
     let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
-    place(ma, &ids_a, &pose_a, &mut pa);
-    place(mb, &ids_b, &pose_b, &mut pb);
-    let best = pairs
-        .iter()
-        .map(|&(x, y)| closest_points_triangle_triangle(&pa.tris[x as usize], &pb.tris[y as usize]))
-        .min_by(|p, q| p.distance.total_cmp(&q.distance))?;
+    pa.now += 1;
+    pb.now += 1;
+    let mut best: Option<crate::geometry::TrianglePair> = None;
+    for (_, _, tp) in &leaf_pairs {
+        for &(x, y) in tp {
+            let tx = *pa.get(x as usize, &pose_a).0;
+            let p = closest_points_triangle_triangle(&tx, pb.get(y as usize, &pose_b).0);
+            if best.is_none_or(|b| p.distance < b.distance) {
+                best = Some(p);
+            }
+        }
+    }
+    let best = best?;
     Some(PairContact {
         time_of_contact: t as f32,
         points: [best.on_first, best.on_second],

@@ -94,7 +94,7 @@ pub fn query(method: Method, a: &Body, b: &Body) -> Option<PairContact> {
     match method {
         Method::Circles => circles::query(a, b),
         Method::Spheres => spheres::query(a, b),
-        Method::Continuous => continuous::query(a, b).map(|c| c.contact),
+        Method::Continuous => continuous::query(a, b, false).map(|c| c.contact),
         Method::Exact => exact::query(a, b),
     }
 }

@@ -15,12 +15,16 @@ pub fn overlapping_leaves(
     pb: &DPose,
     mut leaf: impl FnMut(usize, usize, DVec3, DVec3),
 ) {
+    // Each node's centre, computed once per query.
+    let mut cache_a: Vec<Option<DVec3>> = vec![None; ta.spheres.len()];
+    let mut cache_b: Vec<Option<DVec3>> = vec![None; tb.spheres.len()];
     let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
     stack.push((0, 0));
     while let Some((i, j)) = stack.pop() {
         let (i, j) = (i as usize, j as usize);
         let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let (ca, cb) = (pa.apply(sa.centre), pb.apply(sb.centre));
+        let ca = *cache_a[i].get_or_insert_with(|| pa.apply(sa.centre));
+        let cb = *cache_b[j].get_or_insert_with(|| pb.apply(sb.centre));
         let r = (sa.radius as f64 + sb.radius as f64) * (1.0 + 1e-12) + 1e-12;
         if ca.distance_squared(cb) > r * r {
             continue;
