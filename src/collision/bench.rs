@@ -141,6 +141,7 @@ pub fn near_contact_pairs(
         .map(|t| BroadItem {
             fdi: t.fdi,
             root: t.shape.tree.spheres[0],
+            local_box: t.shape.local_box,
             motion: Motion::still(t.rest),
         })
         .collect();
@@ -324,6 +325,7 @@ pub fn full_mouth_step(teeth: &[BenchTooth], steps: usize, seed: u64) -> f64 {
             items.push(BroadItem {
                 fdi: t.fdi,
                 root: t.shape.tree.spheres[0],
+                local_box: t.shape.local_box,
                 motion: Motion { start: t.rest, end },
             });
         }

@@ -2,14 +2,14 @@
 //!
 //! Each tooth is paired with its neighbours along its arch (extracted teeth skipped, so the teeth on
 //! both sides of an extraction space are neighbours) and with every tooth of the opposing arch; a
-//! pair is kept only if at least one of the two moves and their root spheres, swept over the step
-//! (with the rotation bound of the continuous method), can meet. Conservative: a pair that can
+//! pair is kept only if at least one of the two moves, their swept world boxes overlap, and their
+//! root spheres, swept over the step (with the rotation bound of the continuous method), can meet. Conservative: a pair that can
 //! touch during the step is never dropped... except pairs of non-neighbours in the same arch, which
 //! the arch order rules out (teeth do not pass each other along the arch).
 
 use crate::{
     collision::{motion::Motion, narrow_phase::continuous::may_meet},
-    geometry::Sphere,
+    geometry::{Aabb, Sphere},
     teeth::{Arch, Fdi},
 };
 
@@ -20,8 +20,33 @@ pub struct BroadItem {
     pub fdi: Fdi,
     /// Root sphere of its tree (local frame).
     pub root: Sphere,
+    /// Bounding box of its mesh (local frame).
+    pub local_box: Aabb,
     /// Motion over the step.
     pub motion: Motion,
+}
+
+impl BroadItem {
+    /// A world box holding the tooth throughout the step: the union of the start and end boxes of
+    /// the local box (chord positions of its corners lie between them), grown by the arc–chord bound
+    /// of the farthest corner.
+    pub fn swept_box(&self) -> Aabb {
+        let b = &self.local_box;
+        let boxed = |p: &crate::geometry::Pose| {
+            b.transformed(&glam::Mat3::from_quat(p.rotation), p.translation)
+        };
+        let u = boxed(&self.motion.start).union(boxed(&self.motion.end));
+        let far = b.min.abs().max(b.max.abs()).length() as f64;
+        let grow = (self.motion.arc_factor() * far) as f32 + 1e-4 * (1.0 + far as f32);
+        Aabb {
+            min: u.min - glam::Vec3::splat(grow),
+            max: u.max + glam::Vec3::splat(grow),
+        }
+    }
+}
+
+fn boxes_overlap(a: &Aabb, b: &Aabb) -> bool {
+    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
 }
 
 /// Position along the arch from the patient's right distal end to the left distal end.
@@ -77,8 +102,10 @@ pub fn candidate_pairs(items: &[BroadItem], out: &mut Vec<(usize, usize)>) {
             }
         }
     }
+    let boxes: Vec<Aabb> = items.iter().map(BroadItem::swept_box).collect();
     out.retain(|&(i, j)| {
         !(items[i].motion.is_still() && items[j].motion.is_still())
+            && boxes_overlap(&boxes[i], &boxes[j])
             && swept_roots_meet(&items[i], &items[j])
     });
     out.sort_unstable();

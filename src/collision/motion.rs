@@ -114,6 +114,47 @@ fn dquat(q: Quat) -> DQuat {
     DQuat::from_xyzw(q.x as f64, q.y as f64, q.z as f64, q.w as f64).normalize()
 }
 
+/// Per-thread scratch for per-node values computed once per query: a value is valid when its stamp
+/// equals the current query's stamp, so nothing is cleared or allocated between queries.
+pub(crate) struct NodeCache<T: Copy + Default> {
+    values: Vec<T>,
+    stamps: Vec<u32>,
+    now: u32,
+}
+
+impl<T: Copy + Default> NodeCache<T> {
+    pub(crate) const fn new() -> Self {
+        Self {
+            values: Vec::new(),
+            stamps: Vec::new(),
+            now: 0,
+        }
+    }
+
+    /// Starts a query over `n` nodes.
+    pub(crate) fn begin(&mut self, n: usize) {
+        if self.values.len() < n {
+            self.values.resize(n, T::default());
+            self.stamps.resize(n, 0);
+        }
+        self.now = self.now.wrapping_add(1);
+        if self.now == 0 {
+            self.stamps.iter_mut().for_each(|s| *s = 0);
+            self.now = 1;
+        }
+    }
+
+    /// The value of node `i`, computed by `f` on first use in this query.
+    #[inline]
+    pub(crate) fn get(&mut self, i: usize, f: impl FnOnce() -> T) -> T {
+        if self.stamps[i] != self.now {
+            self.values[i] = f();
+            self.stamps[i] = self.now;
+        }
+        self.values[i]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

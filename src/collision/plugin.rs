@@ -223,6 +223,7 @@ fn broad_phase(teeth: ColliderQuery, mut out: ResMut<BroadPairs>) {
         items.push(BroadItem {
             fdi: tooth.id,
             root: *root,
+            local_box: collider.shape.local_box,
             motion: motion_of(transform, motion),
         });
     }

@@ -132,6 +132,8 @@ pub struct CollisionShape {
     pub tree: Arc<CompactTree>,
     /// Largest distance of a vertex from the local origin (bounds point speeds under rotation).
     pub max_rho: f32,
+    /// Bounding box of the mesh (local frame).
+    pub local_box: crate::geometry::Aabb,
 }
 
 impl CollisionShape {
@@ -144,6 +146,7 @@ impl CollisionShape {
             .map(|v| v.length())
             .fold(0.0, f32::max);
         Self {
+            local_box: geometry.mesh.aabb(),
             geometry,
             tree: Arc::new(CompactTree::new(tree)),
             max_rho,

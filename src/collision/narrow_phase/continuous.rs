@@ -22,7 +22,10 @@
 use glam::DVec3;
 
 use super::{Body, PairContact};
-use crate::{collision::motion::DPose, geometry::interval::Interval};
+use crate::{
+    collision::motion::{DPose, NodeCache},
+    geometry::interval::Interval,
+};
 
 /// A continuous result: the contact at the earliest time, and every leaf pair whose swept spheres
 /// meet during the step with its time.
@@ -89,7 +92,6 @@ pub fn swept_leaves(
     earliest_only: bool,
     mut leaf: impl FnMut(usize, usize, f64),
 ) {
-    let mut best = f64::INFINITY;
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let (a0, a1) = (
         DPose::from_pose(&a.motion.start),
@@ -109,45 +111,104 @@ pub fn swept_leaves(
         + b.shape.max_rho as f64
         + 100.0;
     let slack = 1e-13 * scale + 1e-9;
-    // Each node's start and end centre, computed once per query.
-    let mut cache_a: Vec<Option<[DVec3; 2]>> = vec![None; ta.spheres.len()];
-    let mut cache_b: Vec<Option<[DVec3; 2]>> = vec![None; tb.spheres.len()];
-    let ends = |cache: &mut Vec<Option<[DVec3; 2]>>, p0: &DPose, p1: &DPose, c, n: usize| {
-        *cache[n].get_or_insert_with(|| [p0.apply(c), p1.apply(c)])
-    };
-    let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
-    stack.push((0, 0));
-    while let Some((i, j)) = stack.pop() {
-        let (i, j) = (i as usize, j as usize);
+    CACHE.with_borrow_mut(|(cache_a, cache_b)| {
+        cache_a.begin(ta.spheres.len());
+        cache_b.begin(tb.spheres.len());
+        descend(
+            DescentInput {
+                a,
+                b,
+                poses: [a0, a1, b0, b1],
+                k: [ka, kb],
+                slack,
+                earliest_only,
+            },
+            cache_a,
+            cache_b,
+            &mut leaf,
+        );
+    });
+}
+
+thread_local! {
+    static CACHE: std::cell::RefCell<(EndCache, EndCache)> =
+        const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new())) };
+}
+
+/// Each node's start and end centre (world), per query.
+type EndCache = NodeCache<[DVec3; 2]>;
+
+struct DescentInput<'q, 'a> {
+    a: &'q Body<'a>,
+    b: &'q Body<'a>,
+    poses: [DPose; 4],
+    k: [f64; 2],
+    slack: f64,
+    earliest_only: bool,
+}
+
+fn descend(
+    q: DescentInput,
+    cache_a: &mut EndCache,
+    cache_b: &mut EndCache,
+    leaf: &mut impl FnMut(usize, usize, f64),
+) {
+    let (ta, tb) = (&*q.a.shape.tree, &*q.b.shape.tree);
+    let [a0, a1, b0, b1] = q.poses;
+    let [ka, kb] = q.k;
+    let (slack, earliest_only) = (q.slack, q.earliest_only);
+    let mut best = f64::INFINITY;
+    // The node pair's first time (inflated spheres, linear centres), or None if they cannot meet
+    // during the step; it bounds the times of every pair of their descendants from below.
+    let mut time = |i: usize, j: usize| {
         let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let [ca0, ca1] = ends(&mut cache_a, &a0, &a1, sa.centre, i);
-        let [cb0, cb1] = ends(&mut cache_b, &b0, &b1, sb.centre, j);
+        let [ca0, ca1] = cache_a.get(i, || [a0.apply(sa.centre), a1.apply(sa.centre)]);
+        let [cb0, cb1] = cache_b.get(j, || [b0.apply(sb.centre), b1.apply(sb.centre)]);
         let start = ca0 - cb0;
-        let end = ca1 - cb1;
+        let change = (ca1 - cb1) - start;
         let r = sa.radius as f64
             + sb.radius as f64
             + ka * ta.rho[i] as f64
             + kb * tb.rho[j] as f64
             + slack;
-        let change = end - start;
         if !may_meet(start, change, r) {
+            return None;
+        }
+        first_contact(start, change, r)
+    };
+    // Depth first, the children of a pair visited earliest first, so that with `earliest_only`
+    // a good bound is found early and later subtrees are cut.
+    let mut stack: Vec<(u32, u32, f64)> = Vec::with_capacity(64);
+    if let Some(t) = time(0, 0) {
+        stack.push((0, 0, t));
+    }
+    while let Some((i, j, t)) = stack.pop() {
+        if earliest_only && t >= best {
             continue;
         }
-        // The node spheres' own first time bounds their descendants' from below.
-        let Some(t) = first_contact(start, change, r) else {
-            continue;
-        };
-        if earliest_only && t > best {
-            continue;
-        }
+        let (i, j) = (i as usize, j as usize);
         let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
         if la && lb {
             best = best.min(t);
             leaf(i, j, t);
-        } else if !la && (lb || sa.radius >= sb.radius) {
-            stack.extend(ta.children(i).map(|c| (c as u32, j as u32)));
+            continue;
+        }
+        let first = stack.len();
+        if !la && (lb || ta.spheres[i].radius >= tb.spheres[j].radius) {
+            for c in ta.children(i) {
+                if let Some(t) = time(c, j) {
+                    stack.push((c as u32, j as u32, t));
+                }
+            }
         } else {
-            stack.extend(tb.children(j).map(|c| (i as u32, c as u32)));
+            for c in tb.children(j) {
+                if let Some(t) = time(i, c) {
+                    stack.push((i as u32, c as u32, t));
+                }
+            }
+        }
+        if earliest_only {
+            stack[first..].sort_unstable_by(|x, y| y.2.total_cmp(&x.2));
         }
     }
 }

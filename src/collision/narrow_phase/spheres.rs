@@ -5,7 +5,10 @@
 use glam::DVec3;
 
 use super::{Body, PairContact};
-use crate::collision::{motion::DPose, shape::CompactTree};
+use crate::collision::{
+    motion::{DPose, NodeCache},
+    shape::CompactTree,
+};
 
 /// Calls `leaf(i, j, ca, cb)` for every overlapping leaf pair of the two trees at the given poses.
 pub fn overlapping_leaves(
@@ -15,16 +18,34 @@ pub fn overlapping_leaves(
     pb: &DPose,
     mut leaf: impl FnMut(usize, usize, DVec3, DVec3),
 ) {
-    // Each node's centre, computed once per query.
-    let mut cache_a: Vec<Option<DVec3>> = vec![None; ta.spheres.len()];
-    let mut cache_b: Vec<Option<DVec3>> = vec![None; tb.spheres.len()];
+    CACHE.with_borrow_mut(|(cache_a, cache_b)| {
+        cache_a.begin(ta.spheres.len());
+        cache_b.begin(tb.spheres.len());
+        descend(ta, pa, tb, pb, cache_a, cache_b, &mut leaf);
+    });
+}
+
+thread_local! {
+    static CACHE: std::cell::RefCell<(NodeCache<DVec3>, NodeCache<DVec3>)> =
+        const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new())) };
+}
+
+fn descend(
+    ta: &CompactTree,
+    pa: &DPose,
+    tb: &CompactTree,
+    pb: &DPose,
+    cache_a: &mut NodeCache<DVec3>,
+    cache_b: &mut NodeCache<DVec3>,
+    leaf: &mut impl FnMut(usize, usize, DVec3, DVec3),
+) {
     let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
     stack.push((0, 0));
     while let Some((i, j)) = stack.pop() {
         let (i, j) = (i as usize, j as usize);
         let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let ca = *cache_a[i].get_or_insert_with(|| pa.apply(sa.centre));
-        let cb = *cache_b[j].get_or_insert_with(|| pb.apply(sb.centre));
+        let ca = cache_a.get(i, || pa.apply(sa.centre));
+        let cb = cache_b.get(j, || pb.apply(sb.centre));
         let r = (sa.radius as f64 + sb.radius as f64) * (1.0 + 1e-12) + 1e-12;
         if ca.distance_squared(cb) > r * r {
             continue;
