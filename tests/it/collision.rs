@@ -126,9 +126,12 @@ struct Tally {
     late: usize,
     gap_errors: usize,
     max_gap_diff: f32,
+    /// Largest relative motion of the reported contact points between the exact stage's time and
+    /// the oracle's bisected first-contact time (mm), when measured.
+    max_time_motion: f32,
 }
 
-fn run(pairs: &[(TestTooth, TestTooth)], configs: usize, seed: u64) -> Tally {
+fn run(pairs: &[(TestTooth, TestTooth)], configs: usize, seed: u64, bisect: bool) -> Tally {
     const SAMPLES: usize = 8;
     let mut rng = Rng(seed);
     let mut tally = Tally::default();
@@ -187,6 +190,30 @@ fn run(pairs: &[(TestTooth, TestTooth)], configs: usize, seed: u64) -> Tally {
             if diff > 2e-3 || d > 0.01 + 2e-3 || intersects(a, &pa, b, &pb) {
                 tally.gap_errors += 1;
             }
+            // The oracle's first contact, bisected to 2⁻²⁰ of the step between the last clear
+            // sample and the first intersecting one; how far the contact points move relative to
+            // each other between the two times.
+            if bisect && let Some(t1) = first {
+                let (mut lo, mut hi) = ((t1 - 1.0 / SAMPLES as f32).max(c.time_of_contact), t1);
+                if !intersects(a, &ma.at(lo), b, &mb.at(lo)) {
+                    for _ in 0..20 {
+                        let mid = 0.5 * (lo + hi);
+                        if intersects(a, &ma.at(mid), b, &mb.at(mid)) {
+                            hi = mid;
+                        } else {
+                            lo = mid;
+                        }
+                    }
+                    let (la, lb) = (
+                        pa.inverse().transform_point(c.points[0]),
+                        pb.inverse().transform_point(c.points[1]),
+                    );
+                    let moved =
+                        |t: f32| ma.at(t).transform_point(la) - mb.at(t).transform_point(lb);
+                    let motion = (moved(hi) - moved(c.time_of_contact)).length();
+                    tally.max_time_motion = tally.max_time_motion.max(motion);
+                }
+            }
         }
     }
     tally
@@ -206,7 +233,7 @@ const PAIRS: [(u8, u8); 8] = [
 #[test]
 fn no_false_negatives_against_parry_on_ten_thousand_motions() {
     let pairs = teeth(TreeMethod::Octree, 4, &PAIRS);
-    let t = run(&pairs, 10_000, 0x0c0f_fee5_eed5);
+    let t = run(&pairs, 10_000, 0x0c0f_fee5_eed5, false);
     eprintln!("{t:?}");
     assert!(t.touching > 1000, "the set must exercise contact: {t:?}");
     assert_eq!(t.false_negatives, [0; 4], "{t:?}");
@@ -217,8 +244,12 @@ fn no_false_negatives_against_parry_on_ten_thousand_motions() {
 #[test]
 fn medial_trees_keep_the_guarantees() {
     let pairs = teeth(TreeMethod::Medial, 3, &PAIRS[..3]);
-    let t = run(&pairs, 600, 0x51de_5eed);
+    let t = run(&pairs, 600, 0x51de_5eed, true);
     eprintln!("{t:?}");
+    // The exact stage stops with at most 0.01 mm of gap; in sliding contacts the points still move
+    // farther than that before they touch (0.14 mm at most on this set, measured). A regression
+    // guard, not the goal.
+    assert!(t.max_time_motion > 0.0 && t.max_time_motion < 0.25, "{t:?}");
     assert!(t.touching > 50, "{t:?}");
     assert_eq!(t.false_negatives, [0; 4], "{t:?}");
     assert_eq!(t.late, 0, "{t:?}");
