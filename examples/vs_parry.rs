@@ -1,5 +1,6 @@
 //! orthosim's exact stage beside parry3d's mesh–mesh queries on the same seeded near-contact
-//! motions of real teeth (the `orthosim bench` set, octree trees of depth 4). Prints one JSON object.
+//! motions of real teeth (the `orthosim bench` set, medial trees of depth 4 from the user's tree
+//! cache, built on first use). Prints one JSON object.
 //!
 //! `cargo run --release --example vs_parry [PAIRS]`
 //!
@@ -48,11 +49,12 @@ fn main() {
         .unwrap_or(1000);
     let d = Dentition::build(Case::resolve("normal").expect("built-in case")).expect("valid case");
     let settings = TreeSettings {
-        method: TreeMethod::Octree,
+        method: TreeMethod::Medial,
         branching: 8,
         depth: 4,
     };
-    let teeth = bench::bench_teeth(&d, settings, None);
+    let cache = orthosim::sphere_tree::TreeCache::user_default();
+    let teeth = bench::bench_teeth(&d, settings, cache.as_ref());
     let pairs = bench::near_contact_pairs(&teeth, n, 0x5eed);
     let meshes: Vec<PMesh> = teeth
         .iter()

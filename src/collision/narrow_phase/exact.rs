@@ -6,7 +6,12 @@
 //! at the contact time; so every pair of triangles that can touch during the step is a candidate
 //! pair, and no other pair touches at all.
 //!
-//! Advancement: from the earliest leaf time (no contact can happen before it), a lower bound d on
+//! Windows: the search starts at the earliest leaf time (no contact can happen before it) and covers
+//! the rest of the step in windows of doubling length (1/32 of the step first), each with only the
+//! leaf pairs whose swept spheres meet within it, so a long step does not drag every leaf pair of
+//! its whole sweep into the triangle stage.
+//!
+//! Advancement: from the earliest leaf time in the window, a lower bound d on
 //! the distance between the contact-capable parts (the surface inside each meeting leaf pair) is
 //! computed at the current poses: the exact distance between candidate triangles, visiting leaf
 //! pairs nearest first and skipping a leaf pair once its spheres are farther apart than the best
@@ -24,6 +29,7 @@
 use glam::Vec3;
 
 use super::{Body, PairContact, continuous};
+use crate::collision::motion::Motion;
 use crate::geometry::{MeshRef, closest_points_triangle_triangle, mesh_separation};
 
 /// Largest gap left between teeth reported as touching (mm).
@@ -75,7 +81,49 @@ impl<'m> Placed<'m> {
 
 /// The exact query.
 pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
-    let swept = continuous::query(a, b, true)?;
+    // The earliest leaf time bounds the first contact from below; from there the step is searched
+    // in windows of growing length, each with only the leaf pairs that meet within it (a slerp and
+    // lerp restricted to a sub-interval is the slerp and lerp between its end poses).
+    let first = continuous::query(a, b, false)?;
+    let mut t = first
+        .leaf_times
+        .iter()
+        .map(|x| x.2)
+        .fold(f64::INFINITY, f64::min);
+    let mut window = 1.0 / 32.0;
+    loop {
+        let end = (t + window).min(1.0);
+        let sub = |x: &Body<'_>| Motion {
+            start: x.motion.at(t as f32),
+            end: x.motion.at(end as f32),
+        };
+        let (sa, sb) = (
+            Body {
+                motion: sub(a),
+                ..*a
+            },
+            Body {
+                motion: sub(b),
+                ..*b
+            },
+        );
+        if let Some(swept) = continuous::query(&sa, &sb, true)
+            && let Some(mut c) = advance(&sa, &sb, &swept)
+        {
+            c.time_of_contact = (t + c.time_of_contact as f64 * (end - t)) as f32;
+            return Some(c);
+        }
+        if end >= 1.0 {
+            return None;
+        }
+        t = end;
+        window *= 2.0;
+    }
+}
+
+/// Conservative advancement over the bodies' whole motion, from the earliest meeting leaf time of
+/// `swept` (which must list every meeting leaf pair).
+fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     // Candidate triangles of each side and candidate pairs (as indices into them).
     let mut ids_a: Vec<u32> = Vec::new();
@@ -230,6 +278,6 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
             .try_normalize()
             .unwrap_or(swept.contact.normal),
         depth_mm: -best.distance,
-        leaf_pairs: swept.contact.leaf_pairs,
+        leaf_pairs: swept.contact.leaf_pairs.clone(),
     })
 }
