@@ -8,14 +8,17 @@
 //!
 //! 1. **Interval test.** |A + B·[0, 1]|² is bounded below with outward-rounded interval arithmetic;
 //!    if the bound exceeds (r₁ + r₂)² the spheres cannot meet during the step.
-//! 2. **Exact minimum.** Otherwise the minimum of the quadratic over [0, 1] is computed in f64 and
-//!    compared with a slack of 10⁻¹² relative; both tests can only say "may meet" wrongly, never "cannot".
-//! 3. **Leaves (Eq. 2).** t = (|A|² − R²) / (−A·B + √((A·B)² − |B|²(|A|² − R²))), the conjugate form of
-//!    the paper's root, which has no cancellation; overlap at t = 0 gives 0; |B|² = 0, A·B ≥ 0 or a
-//!    negative discriminant give no contact (the spheres are apart at t = 0 and never approach). The
-//!    time is rounded down by a relative 10⁻¹², so it is never after the true one.
+//! 2. **First time (Eq. 2)**, for every node pair that passes, inner or leaf:
+//!    t = (|A|² − R²) / (−A·B + √((A·B)² − |B|²(|A|² − R²))), the conjugate form of the paper's
+//!    root, which has no cancellation; overlap at t = 0 gives 0; |B|² = 0, A·B ≥ 0 or a negative
+//!    discriminant give no contact (the spheres are apart at t = 0 and never approach). The time is
+//!    rounded down by a relative 10⁻¹², and R carries a slack above the rounding of the transformed
+//!    centres, so it is never after the true one.
 //!
-//! The pair's time of contact is the least leaf time in [0, 1).
+//! A node pair's time bounds its descendants' from below, so the search visits pairs earliest first
+//! and, for the continuous method, skips pairs that cannot beat the earliest leaf time found. The
+//! pair's time of contact is the least leaf time in [0, 1). ([`may_meet`], the interval test plus
+//! the exact minimum of the quadratic, serves the broad phase.)
 //!
 //! [`Motion::arc_factor`]: crate::collision::motion::Motion::arc_factor
 
@@ -37,9 +40,9 @@ pub struct SweptContact {
     pub leaf_times: Vec<(u32, u32, f64)>,
 }
 
-/// False only when the relative centre A + B·t stays farther than `r` for every t in [0, 1].
+/// The interval test alone: false only when |A + B·t|² provably exceeds r² on all of [0, 1].
 #[inline]
-pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
+pub fn interval_may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
     // Each component of A + B·t over t ∈ [0, 1] spans [A, A + B] (linear), the end rounded outward.
     let mut lo = Interval::point(0.0);
     for k in 0..3 {
@@ -47,10 +50,17 @@ pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
         let x = Interval::new(a[k].min(end.lo), a[k].max(end.hi));
         lo = lo.add(x.sqr());
     }
-    let rr = Interval::point(r).sqr().hi;
-    if lo.lo > rr {
+    lo.lo <= Interval::point(r).sqr().hi
+}
+
+/// False only when the relative centre A + B·t stays farther than `r` for every t in [0, 1]: the
+/// interval test, then the exact minimum of the quadratic.
+#[inline]
+pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
+    if !interval_may_meet(a, b, r) {
         return false;
     }
+    let rr = Interval::point(r).sqr().hi;
     let bb = b.length_squared();
     let t = if bb > 0.0 {
         (-a.dot(b) / bb).clamp(0.0, 1.0)
@@ -171,7 +181,8 @@ fn descend(
             + ka * ta.rho[i] as f64
             + kb * tb.rho[j] as f64
             + slack;
-        if !may_meet(start, change, r) {
+        // The interval test, then Eq. 2 itself (which already answers "not in [0, 1)").
+        if !interval_may_meet(start, change, r) {
             return None;
         }
         first_contact(start, change, r)
