@@ -55,6 +55,10 @@ use crate::geometry::{
 const GROWTH: [f32; 12] = [
     0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63,
 ];
+/// The same for budgets under 64 leaves, whose few spheres must each cover much more of the tooth.
+const GROWTH_WIDE: [f32; 16] = [
+    0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63, 0.85, 1.15, 1.5, 2.0,
+];
 /// Largest piece edge, as a fraction of the leaf spacing s.
 const PIECE_EDGE: f32 = 0.3;
 /// Most pieces (finer budgets get coarser pieces than `PIECE_EDGE`).
@@ -260,6 +264,7 @@ fn candidates(
     columns: &Columns,
     seeds: &[usize],
     s: f32,
+    max_leaves: usize,
 ) -> Candidates {
     let start = m.mesh.aabb().extent().length();
     let grid = PieceGrid::new(pieces, s);
@@ -268,28 +273,33 @@ fn candidates(
         pool: Vec::new(),
     };
     let mut near = Vec::new();
-    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); GROWTH.len()];
-    let mut radii = Vec::with_capacity(GROWTH.len());
-    let mut costs = [0.0f64; GROWTH.len()];
+    let growth: &[f32] = if max_leaves < 64 {
+        &GROWTH_WIDE
+    } else {
+        &GROWTH
+    };
+    let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); growth.len()];
+    let mut radii = Vec::with_capacity(growth.len());
+    let mut costs = vec![0.0f64; growth.len()];
     for &k in seeds {
         let ball = medial_ball(m, pieces.centroid[k], pieces.normal[k], start);
-        let r_max = ball.radius + GROWTH[GROWTH.len() - 1] * s;
+        let r_max = ball.radius + growth[growth.len() - 1] * s;
         grid.near(ball.centre, r_max, &mut near);
         // Pieces bucketed by the first growth step that reaches them (no sort needed: a
         // candidate covers whole buckets).
         for b in buckets.iter_mut() {
             b.clear();
         }
-        let mut far = [0.0f32; GROWTH.len()];
+        let mut far = vec![0.0f32; growth.len()];
         for &i in &near {
             let r = reach(&pieces.corners[i as usize], ball.centre);
             if r > r_max {
                 continue;
             }
-            let b = GROWTH
+            let b = growth
                 .iter()
                 .position(|&g| r <= ball.radius + g * s)
-                .unwrap_or(GROWTH.len() - 1);
+                .unwrap_or(growth.len() - 1);
             buckets[b].push(i);
             far[b] = far[b].max(r);
         }
@@ -499,13 +509,29 @@ fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
         };
     }
     if best.is_empty() {
-        // The budget was never met: the largest λ tried gives the fewest spheres; keep raising it.
-        let mut lambda = over.0.max(mean_cost).max(1e-12);
+        // The budget was never met: raise λ until it is, then bisect back towards the largest λ
+        // that was over budget, keeping the largest cover that fits.
+        let mut lo = over.0.max(mean_cost).max(1e-12);
+        let mut hi = lo;
         loop {
-            lambda *= 4.0;
-            let chosen = run(lambda);
+            hi *= 4.0;
+            let chosen = run(hi);
             if chosen.len() <= max_leaves {
-                return chosen;
+                best = chosen;
+                break;
+            }
+            lo = hi;
+        }
+        for _ in 0..RUNS {
+            let mid = (lo * hi).sqrt();
+            let chosen = run(mid);
+            if chosen.len() <= max_leaves {
+                hi = mid;
+                if chosen.len() > best.len() {
+                    best = chosen;
+                }
+            } else {
+                lo = mid;
             }
         }
     }
@@ -569,7 +595,7 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
             seeds.push(i);
         }
     }
-    let cands = candidates(m, &pieces, &columns, &seeds, s);
+    let cands = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
     let chosen = choose(&cands, &pieces.area, max_leaves);
     let mut spheres: Vec<Sphere> = chosen
         .iter()
