@@ -4,56 +4,18 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use orthosim::{
-    collision::{Body, Circle, CollisionShape, Method, Motion, query},
-    geometry::{Pose, TriMesh},
+    collision::{
+        Body, Circle, CollisionShape, Method, Motion,
+        bench::{self, Rng},
+        query,
+    },
+    geometry::Pose,
     sphere_tree::{TreeMethod, TreeSettings},
     teeth::{Case, Dentition, Fdi},
 };
-use parry3d::{
-    math::{Pose as PPose, Rot3, Vector},
-    query as pq,
-    shape::TriMesh as PMesh,
-};
+use parry3d::{query as pq, shape::TriMesh as PMesh};
 
-fn v(p: Vec3) -> Vector {
-    let [x, y, z] = p.to_array();
-    Vector::new(x, y, z)
-}
-
-fn ppose(p: &Pose) -> PPose {
-    let [x, y, z, w] = p.rotation.to_array();
-    PPose::from_parts(v(p.translation), Rot3::from_xyzw(x, y, z, w))
-}
-
-fn pmesh(m: &TriMesh) -> PMesh {
-    PMesh::new(
-        m.vertices.iter().map(|&p| v(p)).collect(),
-        m.triangles.clone(),
-    )
-    .expect("valid mesh")
-}
-
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f32 / (1u64 << 53) as f32
-    }
-    fn vec(&mut self, scale: f32) -> Vec3 {
-        Vec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * 2.0 * scale
-    }
-    fn unit(&mut self) -> Vec3 {
-        loop {
-            let p = self.vec(1.0);
-            if p.length_squared() > 0.01 && p.length_squared() <= 1.0 {
-                return p.normalize();
-            }
-        }
-    }
-}
+use crate::parry_support::{pmesh, ppose};
 
 struct TestTooth {
     shape: CollisionShape,
@@ -86,30 +48,10 @@ fn teeth(method: TreeMethod, depth: u32, pairs: &[(u8, u8)]) -> Vec<(TestTooth, 
     pairs.iter().map(|&(a, b)| (make(a), make(b))).collect()
 }
 
-/// A random step of `t` near its rest pose, heading roughly towards `target`: length 0.01–5 mm
-/// (log-uniform), rotation up to ±15°, sometimes none of either.
+/// A random step of `t` near its rest pose, heading roughly towards `target` (the bench's
+/// generator: 0.01–5 mm, up to ±15°).
 fn random_motion(rng: &mut Rng, t: &TestTooth, target: Vec3) -> Motion {
-    let start = Pose::new(
-        (Quat::from_axis_angle(rng.unit(), rng.vec(2f32.to_radians()).x) * t.rest.rotation)
-            .normalize(),
-        t.rest.translation + rng.vec(0.3),
-    );
-    let kind = rng.next();
-    let length = (0.01f32.ln() + rng.next() * (5.0f32.ln() - 0.01f32.ln())).exp();
-    let dir = ((target - start.translation).normalize_or_zero() + rng.vec(0.6)).normalize_or_zero();
-    let travel = if kind < 0.1 { Vec3::ZERO } else { dir * length };
-    let angle = if kind > 0.9 {
-        0.0
-    } else {
-        rng.vec(15f32.to_radians()).x
-    };
-    Motion {
-        start,
-        end: Pose::new(
-            (Quat::from_axis_angle(rng.unit(), angle) * start.rotation).normalize(),
-            start.translation + travel,
-        ),
-    }
+    bench::random_motion(rng, &t.rest, target)
 }
 
 fn intersects(a: &TestTooth, pa: &Pose, b: &TestTooth, pb: &Pose) -> bool {
@@ -138,7 +80,7 @@ fn run(pairs: &[(TestTooth, TestTooth)], configs: usize, seed: u64, bisect: bool
     for k in 0..configs {
         let (a, b) = &pairs[k % pairs.len()];
         let ma = random_motion(&mut rng, a, b.rest.translation);
-        let mb = if rng.next() < 0.5 {
+        let mb = if rng.uniform() < 0.5 {
             Motion::still(b.rest)
         } else {
             random_motion(&mut rng, b, a.rest.translation)

@@ -5,4 +5,5 @@ mod collision;
 mod ecs;
 mod geometry_props;
 mod oracle;
+mod parry_support;
 mod teeth;

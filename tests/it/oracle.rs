@@ -2,50 +2,20 @@
 
 use glam::{Quat, Vec3};
 use orthosim::{
+    collision::bench::Rng,
     geometry::{
-        MassProperties, Pose, TriMesh, closest_points_triangle_triangle, mesh_separation,
+        MassProperties, Pose, closest_points_triangle_triangle, mesh_separation,
         triangles_intersect,
     },
     teeth::{Case, Dentition, PlacedTooth},
 };
 use parry3d::{
-    math::{Pose as PPose, Rot3, Vector},
+    math::{Pose as PPose, Vector},
     query,
-    shape::{TriMesh as PMesh, Triangle},
+    shape::Triangle,
 };
 
-fn v(p: Vec3) -> Vector {
-    let [x, y, z] = p.to_array();
-    Vector::new(x, y, z)
-}
-
-fn pose(p: &Pose) -> PPose {
-    let [x, y, z, w] = p.rotation.to_array();
-    PPose::from_parts(v(p.translation), Rot3::from_xyzw(x, y, z, w))
-}
-
-fn pmesh(m: &TriMesh) -> PMesh {
-    PMesh::new(
-        m.vertices.iter().map(|&p| v(p)).collect(),
-        m.triangles.clone(),
-    )
-    .expect("valid mesh")
-}
-
-/// A small deterministic generator (xorshift), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f32 / (1u64 << 53) as f32
-    }
-    fn vec(&mut self, scale: f32) -> Vec3 {
-        Vec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * 2.0 * scale
-    }
-}
+use crate::parry_support::{pmesh, ppose as pose, v};
 
 #[test]
 fn triangle_distances_match_parry() {

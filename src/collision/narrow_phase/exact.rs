@@ -173,7 +173,7 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
     let ny = pb.ids.len();
     let mut seen = vec![0u32; pa.ids.len() * ny];
     let mut step = 0u32;
-    for _ in 0..MAX_STEPS {
+    for step in 0..=MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
         pa.now += 1;
         pb.now += 1;
@@ -219,7 +219,8 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
             return None;
         }
         let d = d as f64;
-        if d <= tol {
+        // Within the tolerance, or out of steps: report here (still never after the contact).
+        if d <= tol || step == MAX_STEPS {
             let mut contact = PairContact {
                 time_of_contact: t as f32,
                 points: [qa, qb],
@@ -257,27 +258,5 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
             return None;
         }
     }
-    let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
-    pa.now += 1;
-    pb.now += 1;
-    let mut best: Option<crate::geometry::TrianglePair> = None;
-    for (_, _, tp) in &leaf_pairs {
-        for &(x, y) in tp {
-            let tx = *pa.get(x as usize, &pose_a).0;
-            let p = closest_points_triangle_triangle(&tx, pb.get(y as usize, &pose_b).0);
-            if best.is_none_or(|b| p.distance < b.distance) {
-                best = Some(p);
-            }
-        }
-    }
-    let best = best?;
-    Some(PairContact {
-        time_of_contact: t as f32,
-        points: [best.on_first, best.on_second],
-        normal: (best.on_second - best.on_first)
-            .try_normalize()
-            .unwrap_or(swept.contact.normal),
-        depth_mm: -best.distance,
-        leaf_pairs: swept.contact.leaf_pairs.clone(),
-    })
+    None
 }
