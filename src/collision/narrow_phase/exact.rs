@@ -173,7 +173,7 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
     let ny = pb.ids.len();
     let mut seen = vec![0u32; pa.ids.len() * ny];
     let mut step = 0u32;
-    for step in 0..=MAX_STEPS {
+    for round in 0..=MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
         pa.now += 1;
         pb.now += 1;
@@ -220,7 +220,7 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
         }
         let d = d as f64;
         // Within the tolerance, or out of steps: report here (still never after the contact).
-        if d <= tol || step == MAX_STEPS {
+        if d <= tol || round == MAX_STEPS {
             let mut contact = PairContact {
                 time_of_contact: t as f32,
                 points: [qa, qb],
