@@ -1,5 +1,5 @@
-//! orthosim's exact stage beside parry3d's mesh–mesh queries on the same seeded near-contact
-//! motions of real teeth (the `orthosim bench` set, medial trees of depth 4 from the user's tree
+//! orthosim's exact stage beside parry3d's mesh–mesh queries on the same seeded stress
+//! motions of real teeth (the stress set of `orthosim bench` and the oracle tests, medial trees of depth 4 from the user's tree
 //! cache, built on first use). Prints one JSON object.
 //!
 //! `cargo run --release --example vs_parry [PAIRS]`
@@ -55,7 +55,7 @@ fn main() {
     };
     let cache = orthosim::sphere_tree::TreeCache::user_default();
     let teeth = bench::bench_teeth(&d, settings, cache.as_ref());
-    let pairs = bench::near_contact_pairs(&teeth, n, 0x5eed);
+    let pairs = bench::stress_pairs(&teeth, n, 0x5eed);
     let meshes: Vec<PMesh> = teeth
         .iter()
         .map(|t| {

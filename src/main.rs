@@ -181,7 +181,8 @@ fn run_bench(
         eprint!("building trees…");
     }
     let teeth = bench::bench_teeth(&dentition, settings, cache.as_ref());
-    let set = bench::near_contact_pairs(&teeth, pairs, seed);
+    let near = bench::near_contact_pairs(&teeth, pairs, seed);
+    let stress = bench::stress_pairs(&teeth, pairs, seed);
     let bar = |done: usize, total: usize| {
         if progress {
             eprint!("\rmeasuring {done}/{total}          ");
@@ -190,29 +191,42 @@ fn run_bench(
             }
         }
     };
-    let report = bench::run(&teeth, &set, &bar);
+    let report = bench::run(&teeth, &near, &stress, &bar);
     if json {
         return print_json(&report);
     }
-    println!(
-        "{} near-contact pair motions, {:?} trees (depth 4)",
-        report.pairs, tree
-    );
-    println!(
-        "{:>11} {:>11} {:>9} {:>9} {:>14} {:>13}",
-        "method", "µs/pair", "false neg", "false pos", "mean error mm", "max error mm"
-    );
-    for m in &report.methods {
+    let table = |title: String, methods: &[bench::MethodReport]| {
+        println!("{title}");
         println!(
-            "{:>11} {:>11.2} {:>9} {:>9} {:>14.4} {:>13.4}",
-            m.method,
-            m.us_per_pair,
-            m.false_negatives,
-            m.false_positives,
-            m.mean_error_mm,
-            m.max_error_mm
+            "{:>11} {:>11} {:>9} {:>9} {:>14} {:>13}",
+            "method", "µs/pair", "false neg", "false pos", "mean error mm", "max error mm"
         );
-    }
+        for m in methods {
+            println!(
+                "{:>11} {:>11.2} {:>9} {:>9} {:>14.4} {:>13.4}",
+                m.method,
+                m.us_per_pair,
+                m.false_negatives,
+                m.false_positives,
+                m.mean_error_mm,
+                m.max_error_mm
+            );
+        }
+    };
+    table(
+        format!(
+            "{} near-contact pair steps, {tree:?} trees (depth 4)",
+            report.pairs
+        ),
+        &report.methods,
+    );
+    table(
+        format!(
+            "{} stress pair steps (0.01–5 mm, ±15°), {tree:?} trees (depth 4)",
+            report.stress.pairs
+        ),
+        &report.stress.methods,
+    );
     println!(
         "full-mouth step (continuous): {:.1} µs",
         report.full_mouth_step_us

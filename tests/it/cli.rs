@@ -301,4 +301,11 @@ fn bench_reports_every_method_with_no_false_negatives() {
         exact["max_error_mm"].as_f64().unwrap() <= 0.01 + 1e-6,
         "{exact}"
     );
+    // The stress set: same measures, still no misses.
+    assert_eq!(v["stress"]["pairs"], 60);
+    let stress = v["stress"]["methods"].as_array().unwrap();
+    assert_eq!(stress.len(), 4);
+    for m in &stress[1..] {
+        assert_eq!(m["false_negatives"], 0, "{m}");
+    }
 }
