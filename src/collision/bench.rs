@@ -57,6 +57,20 @@ impl Rng {
             * scale
     }
 
+    /// Log-uniform in [lo, hi).
+    pub fn log_uniform(&mut self, lo: f32, hi: f32) -> f32 {
+        (lo.ln() + self.uniform() * (hi.ln() - lo.ln())).exp()
+    }
+
+    /// `rest` turned by up to ±`degrees` about a random axis and shifted by up to ±`mm` per axis.
+    pub fn perturb(&mut self, rest: &Pose, degrees: f32, mm: f32) -> Pose {
+        let rotation = Quat::from_axis_angle(self.unit(), self.vec(degrees.to_radians()).x);
+        Pose::new(
+            (rotation * rest.rotation).normalize(),
+            rest.translation + self.vec(mm),
+        )
+    }
+
     /// A uniform unit vector.
     pub fn unit(&mut self) -> Vec3 {
         loop {
@@ -112,13 +126,9 @@ pub fn bench_teeth(
 /// A random step near the rest pose heading roughly towards `target`: 0.01–5 mm (log-uniform),
 /// up to ±15° of rotation; one in ten without translation, one in ten without rotation.
 pub fn random_motion(rng: &mut Rng, rest: &Pose, target: Vec3) -> Motion {
-    let start = Pose::new(
-        (Quat::from_axis_angle(rng.unit(), rng.vec(2f32.to_radians()).x) * rest.rotation)
-            .normalize(),
-        rest.translation + rng.vec(0.3),
-    );
+    let start = rng.perturb(rest, 2.0, 0.3);
     let kind = rng.uniform();
-    let length = (0.01f32.ln() + rng.uniform() * (5.0f32.ln() - 0.01f32.ln())).exp();
+    let length = rng.log_uniform(0.01, 5.0);
     let dir = ((target - start.translation).normalize_or_zero() + rng.vec(0.6)).normalize_or_zero();
     let travel = if kind < 0.1 { Vec3::ZERO } else { dir * length };
     let angle = if kind > 0.9 {
@@ -197,13 +207,6 @@ pub fn near_contact_pairs(
     let candidates = close_pairs(teeth);
     let mut rng = Rng(seed);
     let mut out = Vec::with_capacity(n);
-    let perturb = |rng: &mut Rng, rest: &Pose, degrees: f32, mm: f32| {
-        Pose::new(
-            (Quat::from_axis_angle(rng.unit(), rng.vec(degrees.to_radians()).x) * rest.rotation)
-                .normalize(),
-            rest.translation + rng.vec(mm),
-        )
-    };
     let mut k = 0;
     // Every close pair yields near-contact steps for most directions; the cap only guards
     // against a dentition where none does.
@@ -211,12 +214,12 @@ pub fn near_contact_pairs(
         let (i, j) = candidates[k % candidates.len()];
         k += 1;
         let (a, b) = (&teeth[i], &teeth[j]);
-        let pa = perturb(&mut rng, &a.rest, 2.0, 0.3);
-        let pb = perturb(&mut rng, &b.rest, 2.0, 0.3);
+        let pa = rng.perturb(&a.rest, 2.0, 0.3);
+        let pb = rng.perturb(&b.rest, 2.0, 0.3);
         let dir = ((pb.translation - pa.translation).normalize_or_zero() + rng.vec(0.6))
             .normalize_or_zero();
         let extra = rng.vec(0.1).x;
-        let length = (0.01f32.ln() + rng.uniform() * (0.5f32.ln() - 0.01f32.ln())).exp();
+        let length = rng.log_uniform(0.01, 0.5);
         let angle = rng.vec(2f32.to_radians()).x;
         let axis = rng.unit();
         let moves_b = rng.uniform() < 0.5;

@@ -187,12 +187,11 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
     let mut pa = Placed::new(ma, ids_a);
     let mut pb = Placed::new(mb, ids_b);
     let mut order: Vec<(f32, usize)> = Vec::with_capacity(leaf_pairs.len());
-    // Triangle pairs already measured in this step (leaf pairs share triangles).
     let ny = pb.ids.len();
-    let mut seen = vec![0u32; pa.ids.len() * ny];
-    // Each triangle pair's last measured distance and its time: no pair's distance shrinks faster
-    // than μ, so d − μ·(t − t_then) bounds it now and pairs that cannot beat the best are skipped.
-    let mut last = vec![(f32::INFINITY, 0.0f64); pa.ids.len() * ny];
+    // Per triangle pair: the step it was last looked at (leaf pairs share triangles), and its
+    // last measured distance with the time of it: no pair's distance shrinks faster than μ, so
+    // d − μ·(t − t_then) bounds it now and pairs that cannot beat the best are skipped.
+    let mut seen = vec![(0u32, f32::INFINITY, 0.0f64); pa.ids.len() * ny];
     let mut step = 0u32;
     for round in 0..=MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
@@ -219,11 +218,11 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
             }
             for &(x, y) in &leaf_pairs[k].2 {
                 let key = x as usize * ny + y as usize;
-                if seen[key] == step {
+                let (last_step, then_d, then_t) = seen[key];
+                if last_step == step {
                     continue;
                 }
-                seen[key] = step;
-                let (then_d, then_t) = last[key];
+                seen[key].0 = step;
                 if then_d.is_finite()
                     && then_d as f64 - mu * (t - then_t) - LIPSCHITZ_SLACK_MM >= best.0 as f64
                 {
@@ -236,7 +235,7 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
                     continue;
                 }
                 let p = closest_points_triangle_triangle(&tx, ty);
-                last[key] = (p.distance, t);
+                seen[key] = (step, p.distance, t);
                 if p.distance < best.0 {
                     best = (p.distance, p.on_first, p.on_second);
                 }
