@@ -6,7 +6,7 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::{
-    arch::{Arrangement, OcclusionMeasures, Spaces},
+    arch::{ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces},
     case::{CaseError, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
     tooth_shape::{ShapeSet, ToothGeometry},
@@ -88,6 +88,9 @@ pub struct Dentition {
     pub groups: Vec<GroupLoad>,
     /// Occlusion measures of the underlying arrangement (before offsets).
     pub arrangement: OcclusionMeasures,
+    /// The arch forms the teeth's cervical centres were placed on: upper, then lower (the upper
+    /// one at the arrangement's height; the bite opening raises the teeth, not the curve in x–z).
+    pub arch_forms: [BetaArch; 2],
 }
 
 impl Dentition {
@@ -111,6 +114,10 @@ impl Dentition {
                 wire: case.wire_of(fdi),
             })
             .collect();
+        let lift = Vec3::Y * case.bite_opening_mm.0;
+        for tooth in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Upper) {
+            tooth.pose.translation += lift;
+        }
         for tooth in &mut teeth {
             if let Some(offset) = case.offsets.0.get(&tooth.fdi) {
                 let [m, b, o] = tooth.anatomical_axes();
@@ -153,6 +160,7 @@ impl Dentition {
             teeth,
             groups,
             arrangement: arrangement.measures,
+            arch_forms: [arrangement.upper, ArchLayout::default().lower],
         })
     }
 

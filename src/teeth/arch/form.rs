@@ -72,6 +72,36 @@ impl ArchCurve {
     }
 }
 
+impl ArchCurve {
+    /// The signed arc length of the curve point nearest to `p` (x, z): negative on the patient's
+    /// right, as [`ArchCurve::at`] takes it.
+    pub fn project(&self, p: Vec2) -> f32 {
+        let q = Vec2::new(p.x.abs(), p.y);
+        let (end_s, end_p) = *self.table.last().expect("tabulated curve");
+        // The straight continuation behind the last point.
+        let mut best = if q.y <= end_p.y {
+            (end_s + (end_p.y - q.y), (q.x - end_p.x).abs())
+        } else {
+            (end_s, q.distance(end_p))
+        };
+        for w in self.table.windows(2) {
+            let ((s0, p0), (s1, p1)) = (w[0], w[1]);
+            let d = p1 - p0;
+            let len2 = d.length_squared();
+            let f = if len2 > 0.0 {
+                ((q - p0).dot(d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let dist = q.distance(p0 + d * f);
+            if dist < best.1 {
+                best = (s0 + (s1 - s0) * f, dist);
+            }
+        }
+        if p.x < 0.0 { -best.0 } else { best.0 }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,5 +129,19 @@ mod tests {
         // Past the end the curve runs straight back.
         let (far, tf) = curve.at(200.0);
         assert!((far.x - 25.0).abs() < 1e-3 && (tf - Vec2::new(0.0, -1.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn projection_inverts_the_arc_length() {
+        let curve = ArchCurve::new(&BetaArch {
+            width: 50.0,
+            depth: 36.0,
+            front_z: 18.0,
+        });
+        for s in [-60.0f32, -31.5, -12.0, -0.7, 0.0, 3.3, 25.0, 44.0, 58.0] {
+            let (p, _) = curve.at(s);
+            let back = curve.project(p);
+            assert!((back - s).abs() < 0.02, "{s} -> {back}");
+        }
     }
 }

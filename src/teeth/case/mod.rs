@@ -38,6 +38,8 @@ pub const MAX_OFFSET_MM: f32 = 20.0;
 pub const MAX_OFFSET_DEG: f32 = 90.0;
 /// Largest extra space at one contact (mm).
 pub const MAX_SPACE_MM: f32 = 15.0;
+/// Largest bite opening (mm).
+pub const MAX_BITE_OPENING_MM: f32 = 20.0;
 
 /// A case file that could not be read or is not valid.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -103,6 +105,11 @@ pub struct Case {
     /// Movement constraints.
     #[serde(default)]
     pub constraints: Vec<CaseConstraint>,
+    /// Vertical opening of the bite (mm): the upper arch is raised this far from normal occlusion, as
+    /// when teeth are moved with the jaws apart (interdigitated cusps would otherwise lock the arches
+    /// against any movement along them). Default 0: the arches in occlusion.
+    #[serde(default)]
+    pub bite_opening_mm: NonNegative,
     /// Mesh files per tooth, relative to the case file (mesh import is a later feature).
     #[serde(default)]
     pub meshes: ToothMap<String>,
@@ -230,6 +237,16 @@ impl Case {
                 "resolution",
                 Some(r.to_string()),
                 format!("resolution must be 20–200000 vertices, got {r}"),
+            ));
+        }
+        if self.bite_opening_mm.0 > MAX_BITE_OPENING_MM {
+            return Err((
+                "bite_opening_mm",
+                None,
+                format!(
+                    "bite opening of {} mm is beyond the {MAX_BITE_OPENING_MM} mm accepted",
+                    self.bite_opening_mm.0
+                ),
             ));
         }
         for f in &self.extracted.0 {
