@@ -13,6 +13,7 @@
 //! | [`teeth::TeethModelPlugin`] | [`teeth`] | patient cases, tooth entities with shared shapes |
 //! | [`sphere_tree::SphereTreePlugin`] | [`sphere_tree`] | sphere trees per tooth shape, built in the background |
 //! | [`collision::CollisionPlugin`] | [`collision`] | broad and narrow phases, contacts of moving teeth |
+//! | [`movement::MovementPlugin`] | [`movement`] | loads, wire models, motion per step, block / impulse / IPR responses |
 //! | `OcclusionViewPlugin` (feature `viewer`) | `occlusion_view` | rendering, orbit camera |
 
 //!
@@ -22,6 +23,7 @@
 pub mod analysis;
 pub mod collision;
 pub mod geometry;
+pub mod movement;
 #[cfg(feature = "viewer")]
 pub mod occlusion_view;
 pub mod parallel;
@@ -37,6 +39,7 @@ use bevy::{app::PluginGroupBuilder, prelude::*};
 /// | [`teeth::TeethModelPlugin`] | loads cases, spawns teeth |
 /// | [`sphere_tree::SphereTreePlugin`] | builds each tooth shape's sphere tree in the background |
 /// | [`collision::CollisionPlugin`] | finds the contacts of moving teeth each simulation step |
+/// | [`movement::MovementPlugin`] | moves loaded teeth, responds to contacts, passes loads on |
 ///
 /// Swap one out with `OrthoSimPlugins.build().disable::<…>()`.
 pub struct OrthoSimPlugins;
@@ -47,6 +50,7 @@ impl PluginGroup for OrthoSimPlugins {
             .add(teeth::TeethModelPlugin::default())
             .add(sphere_tree::SphereTreePlugin)
             .add(collision::CollisionPlugin::default())
+            .add(movement::MovementPlugin::default())
     }
 }
 

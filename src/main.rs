@@ -6,6 +6,8 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use orthosim::{
     analysis::inspect,
+    collision::Method,
+    movement::{MovementSettings, Response, run_case},
     sphere_tree::{
         TreeCache, TreeMethod, TreeSettings,
         report::{trees_report, write_atomic},
@@ -35,6 +37,34 @@ enum Command {
     },
     /// List the built-in cases, one line each.
     Cases,
+    /// Run a case headless until the teeth come to rest and report where they went.
+    Simulate {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "case1")]
+        case: String,
+        /// Narrow-phase method.
+        #[arg(long, value_enum, default_value_t = Method::Continuous)]
+        algorithm: Method,
+        /// Collision response.
+        #[arg(long, value_enum, default_value_t = Response::Block)]
+        response: Response,
+        /// Most steps to run.
+        #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+        max_steps: u64,
+        /// Sphere-tree builder (depth 4, branching 8).
+        #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
+        tree: TreeMethod,
+        /// Build every tree afresh instead of using the user's tree cache.
+        #[arg(long)]
+        no_cache: bool,
+        /// Movement settings (a RON `MovementSettings`; missing fields keep their defaults);
+        /// `--response` overrides the file's response.
+        #[arg(long)]
+        settings: Option<std::path::PathBuf>,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print per-tooth mesh data and exact gaps and penetrations of a case.
     Inspect {
         /// Built-in case name or path to a .ron case file.
@@ -137,6 +167,25 @@ fn main() -> ExitCode {
             no_cache,
             json,
         } => run_bench(&case, pairs as usize, tree, seed, no_cache, json),
+        Command::Simulate {
+            case,
+            algorithm,
+            response,
+            max_steps,
+            tree,
+            no_cache,
+            settings,
+            json,
+        } => run_simulate(
+            &case,
+            algorithm,
+            response,
+            max_steps,
+            tree,
+            no_cache,
+            settings.as_deref(),
+            json,
+        ),
         Command::Cases => {
             list_cases();
             Ok(())
@@ -231,6 +280,105 @@ fn run_bench(
         "full-mouth step (continuous): {:.1} µs",
         report.full_mouth_step_us
     );
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_simulate(
+    case: &str,
+    method: Method,
+    response: Response,
+    max_steps: u64,
+    tree: TreeMethod,
+    no_cache: bool,
+    settings_file: Option<&std::path::Path>,
+    json: bool,
+) -> Result<()> {
+    let mut settings = match settings_file {
+        Some(path) => MovementSettings::load(path)?,
+        None => MovementSettings::default(),
+    };
+    settings.response = response;
+    let cache = if no_cache {
+        None
+    } else {
+        TreeCache::user_default()
+    };
+    let progress = std::io::stderr().is_terminal();
+    if progress {
+        eprint!("building trees…");
+    }
+    let trees = TreeSettings {
+        method: tree,
+        branching: 8,
+        depth: 4,
+    };
+    let run = run_case(
+        case,
+        method,
+        settings,
+        trees,
+        cache.as_ref(),
+        max_steps,
+        |step| {
+            if progress && (step % 50 == 0 || step == max_steps) {
+                eprint!("\rsimulating: step {step}/{max_steps}          ");
+            }
+        },
+    )?;
+    if progress {
+        eprintln!();
+    }
+    let r = &run.report;
+    if json {
+        return print_json(r);
+    }
+    println!(
+        "case {}, {} / {}: {} steps, {}",
+        r.case,
+        r.algorithm,
+        r.response,
+        r.steps,
+        if r.at_rest {
+            "at rest"
+        } else {
+            "not at rest (step limit)"
+        }
+    );
+    println!(
+        "moved (> 0.1 mm): {}",
+        r.moved
+            .iter()
+            .map(|f| f.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    println!("{:>7} {:>14} {:>12}", "pair", "centre dist mm", "gap mm");
+    for d in &r.distances {
+        println!(
+            "{:>7} {:>14.3} {:>12.4}",
+            format!("{}-{}", d.a, d.b),
+            d.centre_distance_mm,
+            d.surface_gap_mm
+        );
+    }
+    println!(
+        "total centre distance {:.3} mm, max penetration {:.4} mm",
+        r.total_centre_distance_mm, r.max_penetration_mm
+    );
+    println!(
+        "{:.1} µs per step ({:.1} µs collision)",
+        r.step_us, r.collision_us_per_step
+    );
+    for (pair, mm) in &r.ipr_mm {
+        println!("IPR {pair}: {mm:.3} mm");
+    }
+    if r.impacts > 0 {
+        println!(
+            "{} impacts, {:.3e} µJ of kinetic energy lost",
+            r.impacts, r.energy_lost_uj
+        );
+    }
     Ok(())
 }
 

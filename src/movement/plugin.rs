@@ -1,0 +1,302 @@
+//! `MovementPlugin`: the ECS layer over [`Simulation`].
+//!
+//! Once every visible tooth of the [`ActiveCase`] has its collider (its sphere tree is built), a
+//! [`Simulation`] of the case is made and kept in [`SimulationState`]. Each step of the simulation
+//! schedule (default `FixedUpdate`) then runs its stages in the [`SimulationSystems`] sets:
+//! `Loads` (loads set by [`SetLoad`] messages or changed [`Load`] components), `Motion` (each
+//! tooth's [`ToothMotion`] for the step), the collision plugin's `BroadPhase` and `NarrowPhase`,
+//! `Resolve` (the response to the [`Contacts`], see [`super::sim`]) and `Commit` (end poses
+//! written to `Transform`, [`MovementStatus`] updated, a [`ToothImpact`] message per impact).
+//! A new case, or a change of the collision method, starts a new simulation.
+
+use std::sync::Arc;
+
+use bevy::{ecs::schedule::ScheduleLabel, prelude::*};
+
+use super::{
+    settings::MovementSettings,
+    sim::{Found, Impact, Simulation},
+};
+use crate::{
+    collision::{
+        CollisionSettings, Contacts, PairContact, SimulationSystems, ToothCollider, ToothMotion,
+        motion::Motion,
+    },
+    teeth::{ActiveCase, Dentition, Extracted, Load, Tooth},
+};
+
+/// The running simulation of the active case.
+#[derive(Resource, Default)]
+pub struct SimulationState {
+    /// The simulation, once every tooth is ready.
+    pub sim: Option<Simulation>,
+    /// The entity of each simulated tooth (same order as `sim.teeth`).
+    pub entities: Vec<Entity>,
+    /// The case it was made for.
+    case: Option<Arc<Dentition>>,
+}
+
+impl SimulationState {
+    /// The simulation index of an entity.
+    pub fn index_of(&self, e: Entity) -> Option<usize> {
+        self.entities.iter().position(|x| *x == e)
+    }
+}
+
+/// Progress of the simulation, for readouts.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct MovementStatus {
+    /// Steps taken.
+    pub steps: u64,
+    /// Teeth that moved in the last step.
+    pub moved: usize,
+    /// Nothing moves any more.
+    pub at_rest: bool,
+}
+
+/// Set a tooth's load from code (replaces its own load).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SetLoad {
+    /// The tooth.
+    pub tooth: Entity,
+    /// Its new load (world frame).
+    pub load: Load,
+}
+
+/// An impact of the `impulse` response.
+#[derive(Message, Clone, Debug, PartialEq, Deref)]
+pub struct ToothImpact(pub Impact);
+
+/// Tooth movement and the response to contacts.
+pub struct MovementPlugin {
+    /// Schedule the simulation runs in (the collision plugin's).
+    pub schedule: bevy::ecs::intern::Interned<dyn ScheduleLabel>,
+}
+
+impl Default for MovementPlugin {
+    fn default() -> Self {
+        Self {
+            schedule: FixedUpdate.intern(),
+        }
+    }
+}
+
+impl Plugin for MovementPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<MovementSettings>()
+            .init_resource::<SimulationState>()
+            .init_resource::<MovementStatus>()
+            .add_message::<SetLoad>()
+            .add_message::<ToothImpact>()
+            .add_systems(
+                self.schedule,
+                (
+                    start_simulation.before(SimulationSystems::Loads),
+                    apply_loads.in_set(SimulationSystems::Loads),
+                    propose.in_set(SimulationSystems::Motion),
+                    resolve.in_set(SimulationSystems::Resolve),
+                    commit.in_set(SimulationSystems::Commit),
+                ),
+            );
+    }
+}
+
+type TeethQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Tooth,
+        Option<&'static ToothCollider>,
+        &'static Transform,
+    ),
+    Without<Extracted>,
+>;
+
+/// Makes the simulation when a case is ready (or restarts it when the case, the method or the
+/// settings change).
+fn start_simulation(
+    mut commands: Commands,
+    mut state: ResMut<SimulationState>,
+    case: Option<Res<ActiveCase>>,
+    collision: Res<CollisionSettings>,
+    settings: Res<MovementSettings>,
+    teeth: TeethQuery,
+) {
+    let Some(case) = case else {
+        return;
+    };
+    let same_case = state.case.as_ref().is_some_and(|c| Arc::ptr_eq(c, &case.0));
+    if let Some(sim) = state.sim.as_mut()
+        && same_case
+    {
+        if sim.method != collision.method {
+            sim.method = collision.method;
+        }
+        if settings.is_changed() && sim.settings != *settings {
+            match settings.validate() {
+                Ok(()) => sim.settings = *settings,
+                Err(e) => error!("{e}; keeping the previous movement settings"),
+            }
+        }
+        return;
+    }
+    if !same_case {
+        state.sim = None;
+        state.case = Some(case.0.clone());
+    }
+    let visible: Vec<_> = case.visible().map(|t| t.fdi).collect();
+    let mut entities = Vec::new();
+    let mut shapes = Vec::new();
+    for fdi in &visible {
+        let Some((e, _, Some(collider), _)) = teeth.iter().find(|(_, t, _, _)| t.id == *fdi) else {
+            return;
+        };
+        entities.push(e);
+        shapes.push((*fdi, collider.shape.clone()));
+    }
+    match Simulation::new(&case.0, shapes, collision.method, *settings) {
+        Ok(sim) => {
+            for (e, t) in entities.iter().zip(&sim.teeth) {
+                commands
+                    .entity(*e)
+                    .try_insert(ToothMotion(Motion::still(t.pose)));
+            }
+            state.sim = Some(sim);
+            state.entities = entities;
+        }
+        Err(e) => error!("cannot simulate case '{}': {e}", case.case.case.name),
+    }
+}
+
+fn apply_loads(
+    mut state: ResMut<SimulationState>,
+    mut messages: MessageReader<SetLoad>,
+    mut loads: Query<(Entity, &mut Load), Without<Extracted>>,
+) {
+    let state = &mut *state;
+    let Some(sim) = state.sim.as_mut() else {
+        messages.clear();
+        return;
+    };
+    for m in messages.read() {
+        if !(m.load.force.is_finite() && m.load.torque.is_finite()) {
+            warn!("ignored a load with non-finite components");
+            continue;
+        }
+        if let Ok((_, mut l)) = loads.get_mut(m.tooth) {
+            *l = m.load;
+        }
+    }
+    for (e, load) in loads.iter_mut() {
+        if !load.is_changed() {
+            continue;
+        }
+        if !(load.force.is_finite() && load.torque.is_finite()) {
+            warn!("ignored a load with non-finite components");
+            continue;
+        }
+        if let Some(i) = state.entities.iter().position(|x| *x == e) {
+            sim.set_load(i, *load);
+        }
+    }
+}
+
+fn write_motions(state: &SimulationState, motions: &mut Query<&mut ToothMotion>) {
+    let Some(sim) = state.sim.as_ref() else {
+        return;
+    };
+    for (e, m) in state.entities.iter().zip(&sim.motions) {
+        if let Ok(mut tm) = motions.get_mut(*e)
+            && tm.0 != *m
+        {
+            tm.0 = *m;
+        }
+    }
+}
+
+fn propose(mut state: ResMut<SimulationState>, mut motions: Query<&mut ToothMotion>) {
+    if let Some(sim) = state.sim.as_mut() {
+        sim.propose();
+    }
+    write_motions(&state, &mut motions);
+}
+
+fn resolve(
+    mut state: ResMut<SimulationState>,
+    contacts: Res<Contacts>,
+    mut motions: Query<&mut ToothMotion>,
+) {
+    let state_ref = &mut *state;
+    let Some(sim) = state_ref.sim.as_mut() else {
+        return;
+    };
+    let moving = sim.motions.iter().any(|m| !m.is_still());
+    let mut found = Vec::new();
+    if moving {
+        for c in &contacts.list {
+            let (Some(i), Some(j)) = (
+                state_ref.entities.iter().position(|x| *x == c.a),
+                state_ref.entities.iter().position(|x| *x == c.b),
+            ) else {
+                continue;
+            };
+            let mut contact = PairContact {
+                time_of_contact: c.time_of_contact,
+                points: c.points,
+                normal: c.normal,
+                depth_mm: c.depth_mm,
+                leaf_pairs: c.leaf_pairs.clone(),
+            };
+            let (a, b) = if i < j {
+                (i, j)
+            } else {
+                contact.points.swap(0, 1);
+                contact.normal = -contact.normal;
+                contact.leaf_pairs.iter_mut().for_each(|p| *p = (p.1, p.0));
+                (j, i)
+            };
+            found.push(Found { a, b, contact });
+        }
+    }
+    sim.resolve(found);
+    write_motions(&state, &mut motions);
+}
+
+fn commit(
+    mut state: ResMut<SimulationState>,
+    mut status: ResMut<MovementStatus>,
+    mut transforms: Query<&mut Transform, With<Tooth>>,
+    mut motions: Query<&mut ToothMotion>,
+    mut impacts: MessageWriter<ToothImpact>,
+) {
+    let state_ref = &mut *state;
+    let Some(sim) = state_ref.sim.as_mut() else {
+        return;
+    };
+    sim.commit();
+    for (e, t) in state_ref.entities.iter().zip(&sim.teeth) {
+        if let Ok(mut tf) = transforms.get_mut(*e)
+            && (tf.translation != t.pose.translation || tf.rotation != t.pose.rotation)
+        {
+            tf.translation = t.pose.translation;
+            tf.rotation = t.pose.rotation;
+        }
+        if let Ok(mut m) = motions.get_mut(*e)
+            && !m.is_still()
+        {
+            m.0 = Motion::still(t.pose);
+        }
+    }
+    for i in &sim.last.impacts {
+        impacts.write(ToothImpact(i.clone()));
+    }
+    let new = MovementStatus {
+        steps: sim.steps,
+        moved: sim.last.moved,
+        at_rest: sim.last.at_rest,
+    };
+    if *status != new {
+        *status = new;
+    }
+}

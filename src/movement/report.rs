@@ -1,0 +1,258 @@
+//! Running a case to rest and measuring the result: the `simulate` command's JSON.
+//!
+//! Measures: `moved` lists teeth whose crown centre travelled more than [`MOVED_MM`];
+//! `centre_distance_mm` is the paper's distance between adjacent crown centres in the x–z plane;
+//! `surface_gap_mm` is the exact minimal distance between the meshes (negative: penetration);
+//! `max_penetration_mm` is the exact triangle-level penetration depth, the largest over every pair
+//! of teeth whose boxes overlap at the end.
+
+use std::{collections::BTreeMap, sync::Arc, time::Instant};
+
+use serde::Serialize;
+
+use super::{
+    settings::{MovementSettings, Response},
+    sim::Simulation,
+};
+use crate::{
+    collision::{CollisionShape, Method},
+    geometry::mesh_separation,
+    sphere_tree::{TreeCache, TreeSettings, build::TreeBuildError},
+    teeth::{Arch, Case, Dentition, Fdi, ToothGeometry},
+};
+
+/// Crown-centre travel above which a tooth counts as moved (mm).
+pub const MOVED_MM: f32 = 0.1;
+
+/// Distance between two adjacent teeth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PairDistance {
+    /// First tooth (the patient's right of the two).
+    pub a: Fdi,
+    /// Second tooth.
+    pub b: Fdi,
+    /// Distance of the crown centres in the x–z plane (mm).
+    pub centre_distance_mm: f32,
+    /// Exact surface gap (mm); negative when they overlap.
+    pub surface_gap_mm: f32,
+}
+
+/// The result of `orthosim simulate`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SimulationReport {
+    /// Case name.
+    pub case: String,
+    /// Narrow-phase method.
+    pub algorithm: String,
+    /// Collision response.
+    pub response: String,
+    /// Steps taken.
+    pub steps: u64,
+    /// True when the teeth came to rest before the step limit.
+    pub at_rest: bool,
+    /// Teeth whose crown centre moved more than 0.1 mm.
+    pub moved: Vec<Fdi>,
+    /// Crown-centre travel per tooth (mm), keyed by FDI number.
+    pub displacement_mm: BTreeMap<String, f32>,
+    /// Largest exact penetration between any two teeth at the end (mm).
+    pub max_penetration_mm: f32,
+    /// Adjacent teeth along each arch.
+    pub distances: Vec<PairDistance>,
+    /// Sum of the adjacent centre distances (mm).
+    pub total_centre_distance_mm: f32,
+    /// Mean collision detection and response time per step (µs).
+    pub collision_us_per_step: f64,
+    /// Mean time per step, everything included (µs).
+    pub step_us: f64,
+    /// Interproximal reduction per contact (mm), keyed "a-b" (`ipr` response).
+    pub ipr_mm: BTreeMap<String, f32>,
+    /// Impacts (`impulse` response).
+    pub impacts: usize,
+    /// Kinetic energy lost in all impacts (µJ).
+    pub energy_lost_uj: f64,
+}
+
+/// Adjacent present teeth along each arch, from the patient's right to left (indices).
+pub fn neighbour_pairs(sim: &Simulation) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    for arch in [Arch::Upper, Arch::Lower] {
+        let mut row: Vec<usize> = (0..sim.teeth.len())
+            .filter(|&i| sim.teeth[i].fdi.arch() == arch)
+            .collect();
+        row.sort_by_key(|&i| sim.teeth[i].fdi.arch_index());
+        out.extend(row.windows(2).map(|w| (w[0], w[1])));
+    }
+    out
+}
+
+/// Centre distances and exact gaps of adjacent teeth.
+pub fn pair_distances(sim: &Simulation) -> Vec<PairDistance> {
+    neighbour_pairs(sim)
+        .into_iter()
+        .map(|(i, j)| {
+            let (a, b) = (&sim.teeth[i], &sim.teeth[j]);
+            let (ca, cb) = (a.crown_centre(), b.crown_centre());
+            let centre = glam::Vec2::new(ca.x - cb.x, ca.z - cb.z).length();
+            let gap = mesh_separation(
+                a.shape.geometry.mesh_ref(),
+                &a.pose,
+                b.shape.geometry.mesh_ref(),
+                &b.pose,
+            )
+            .signed_gap();
+            PairDistance {
+                a: a.fdi,
+                b: b.fdi,
+                centre_distance_mm: centre,
+                surface_gap_mm: gap,
+            }
+        })
+        .collect()
+}
+
+/// The largest exact penetration depth between any two teeth (0 when none overlap).
+pub fn max_penetration(sim: &Simulation) -> f32 {
+    let boxes: Vec<_> = sim
+        .teeth
+        .iter()
+        .map(|t| {
+            t.shape
+                .local_box
+                .transformed(&glam::Mat3::from_quat(t.pose.rotation), t.pose.translation)
+        })
+        .collect();
+    let mut worst = 0.0f32;
+    for i in 0..sim.teeth.len() {
+        for j in i + 1..sim.teeth.len() {
+            let (bi, bj) = (&boxes[i], &boxes[j]);
+            if !(bi.min.cmple(bj.max).all() && bj.min.cmple(bi.max).all()) {
+                continue;
+            }
+            let (a, b) = (&sim.teeth[i], &sim.teeth[j]);
+            let sep = mesh_separation(
+                a.shape.geometry.mesh_ref(),
+                &a.pose,
+                b.shape.geometry.mesh_ref(),
+                &b.pose,
+            );
+            if sep.overlapping() {
+                worst = worst.max(sep.penetration);
+            }
+        }
+    }
+    worst
+}
+
+/// Collision shapes of the visible teeth of `d`, each distinct tooth shape's tree built once (in
+/// parallel) or read from `cache`.
+pub fn collision_shapes(
+    d: &Dentition,
+    trees: TreeSettings,
+    cache: Option<&TreeCache>,
+) -> Result<Vec<(Fdi, CollisionShape)>, TreeBuildError> {
+    trees.validate()?;
+    let mut distinct: Vec<Arc<ToothGeometry>> = Vec::new();
+    for t in d.visible() {
+        if !distinct.iter().any(|g| Arc::ptr_eq(g, &t.geometry)) {
+            distinct.push(t.geometry.clone());
+        }
+    }
+    let built = crate::parallel::parallel_map(&distinct, |g| match cache {
+        Some(c) => c.load_or_build(&trees, &g.mesh, &g.bvh).map(|x| x.0),
+        None => trees.build(&g.mesh, &g.bvh),
+    });
+    let mut shapes = Vec::with_capacity(distinct.len());
+    for (g, tree) in distinct.iter().zip(built) {
+        shapes.push(CollisionShape::new(g.clone(), &tree?));
+    }
+    Ok(d.visible()
+        .map(|t| {
+            let k = distinct
+                .iter()
+                .position(|g| Arc::ptr_eq(g, &t.geometry))
+                .expect("listed above");
+            (t.fdi, shapes[k].clone())
+        })
+        .collect())
+}
+
+/// A finished run: the report and the simulation in its final state.
+pub struct CaseRun {
+    /// The measures.
+    pub report: SimulationReport,
+    /// The simulation at the end.
+    pub simulation: Simulation,
+}
+
+/// Loads a case, builds its teeth's trees (`cache` if given), and steps until the teeth rest or
+/// `max_steps` pass; `progress(step)` is called after every step.
+pub fn run_case(
+    case: &str,
+    method: Method,
+    settings: MovementSettings,
+    trees: TreeSettings,
+    cache: Option<&TreeCache>,
+    max_steps: u64,
+    mut progress: impl FnMut(u64),
+) -> anyhow::Result<CaseRun> {
+    let loaded = Case::resolve(case)?;
+    let name = loaded.case.name.clone();
+    let d = Dentition::build(loaded)?;
+    let shapes = collision_shapes(&d, trees, cache)?;
+    let mut sim = Simulation::new(&d, shapes, method, settings)
+        .map_err(|e| anyhow::anyhow!("{case}: {e}"))?;
+    let start = Instant::now();
+    let mut collision_ns = 0u64;
+    let mut at_rest = false;
+    while sim.steps < max_steps {
+        let out = sim.step();
+        collision_ns += out.collision_ns;
+        at_rest = out.at_rest;
+        progress(sim.steps);
+        if at_rest {
+            break;
+        }
+    }
+    let elapsed = start.elapsed().as_secs_f64() * 1e6;
+    let steps = sim.steps.max(1) as f64;
+    let distances = pair_distances(&sim);
+    let report = SimulationReport {
+        case: name,
+        algorithm: method.name().to_owned(),
+        response: match settings.response {
+            Response::Block => "block",
+            Response::Impulse => "impulse",
+            Response::Ipr => "ipr",
+        }
+        .to_owned(),
+        steps: sim.steps,
+        at_rest,
+        moved: sim
+            .teeth
+            .iter()
+            .filter(|t| t.displacement_mm() > MOVED_MM)
+            .map(|t| t.fdi)
+            .collect(),
+        displacement_mm: sim
+            .teeth
+            .iter()
+            .map(|t| (t.fdi.to_string(), t.displacement_mm()))
+            .collect(),
+        max_penetration_mm: max_penetration(&sim),
+        total_centre_distance_mm: distances.iter().map(|d| d.centre_distance_mm).sum(),
+        distances,
+        collision_us_per_step: collision_ns as f64 / 1e3 / steps,
+        step_us: elapsed / steps,
+        ipr_mm: sim
+            .ipr
+            .iter()
+            .map(|((a, b), v)| (format!("{a}-{b}"), *v))
+            .collect(),
+        impacts: sim.total_impacts,
+        energy_lost_uj: sim.total_energy_lost_uj,
+    };
+    Ok(CaseRun {
+        report,
+        simulation: sim,
+    })
+}
