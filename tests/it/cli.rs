@@ -309,3 +309,70 @@ fn bench_reports_every_method_with_no_false_negatives() {
         assert_eq!(m["false_negatives"], 0, "{m}");
     }
 }
+
+#[test]
+fn simulate_reports_the_contract_keys() {
+    let out = orthosim(&[
+        "simulate",
+        "--case",
+        "case3",
+        "--algorithm",
+        "circles",
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--max-steps",
+        "40",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    for key in [
+        "case",
+        "algorithm",
+        "response",
+        "steps",
+        "at_rest",
+        "moved",
+        "displacement_mm",
+        "max_penetration_mm",
+        "distances",
+        "total_centre_distance_mm",
+        "collision_us_per_step",
+        "step_us",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    assert_eq!(v["case"], "case3");
+    assert_eq!(v["algorithm"], "circles");
+    assert_eq!(v["response"], "block");
+    assert!(v["steps"].as_u64().unwrap() <= 40);
+    let distances = v["distances"].as_array().unwrap();
+    assert_eq!(distances.len(), 30, "15 adjacent pairs per arch");
+    for d in distances {
+        for key in ["a", "b", "centre_distance_mm", "surface_gap_mm"] {
+            assert!(d.get(key).is_some(), "{d}");
+        }
+    }
+    assert_eq!(v["displacement_mm"].as_object().unwrap().len(), 32);
+    let total: f64 = distances
+        .iter()
+        .map(|d| d["centre_distance_mm"].as_f64().unwrap())
+        .sum();
+    assert!((total - v["total_centre_distance_mm"].as_f64().unwrap()).abs() < 1e-3);
+}
+
+#[test]
+fn simulate_refuses_unknown_cases_and_bad_options_in_one_line() {
+    let out = orthosim(&["simulate", "--case", "nosuch"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("nosuch"), "{err}");
+    let out = orthosim(&["simulate", "--response", "bounce"]);
+    assert!(!out.status.success());
+}

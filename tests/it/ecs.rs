@@ -10,8 +10,13 @@ use orthosim::{
 
 /// A headless app with the simulation plugins and a manual clock.
 fn create_app() -> App {
+    app_with(OrthoSimPlugins.build())
+}
+
+/// A headless app with the given plugins and a manual clock.
+fn app_with(plugins: bevy::app::PluginGroupBuilder) -> App {
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, TransformPlugin, OrthoSimPlugins))
+    app.add_plugins((MinimalPlugins, TransformPlugin, plugins))
         .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
             16,
         )));
@@ -206,7 +211,13 @@ fn a_moving_tooth_reports_contacts_and_nothing_runs_when_nothing_moves() {
         collision::{ContactStarted, Contacts, Motion, ToothCollider, ToothContact, ToothMotion},
         geometry::Pose,
     };
-    let mut app = create_app();
+    // Motions are set by hand here: the collision plugin alone, without the movement plugin
+    // (which would write every tooth's motion each step).
+    let mut app = app_with(
+        OrthoSimPlugins
+            .build()
+            .disable::<orthosim::movement::MovementPlugin>(),
+    );
     app.init_resource::<Started>().add_observer(
         |ev: On<ContactStarted>, mut started: ResMut<Started>| {
             started.0.push((ev.entity, ev.other));

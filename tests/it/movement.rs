@@ -1,0 +1,364 @@
+//! Tooth movement: the paper's three cases reproduced headless, the three responses, determinism,
+//! rest and the ECS layer.
+//!
+//! Runs use medial trees (depth 4) built once per test process into a private tree cache, and a
+//! step four times the default (the same model, coarser in time) so that the cases run to rest in
+//! a few hundred steps.
+
+use std::{sync::OnceLock, time::Duration};
+
+use bevy::{prelude::*, time::TimeUpdateStrategy};
+use orthosim::{
+    collision::Method,
+    movement::{
+        MovementSettings, MovementStatus, Response, Simulation, SimulationState,
+        report::{CaseRun, collision_shapes, max_penetration, run_case},
+    },
+    prelude::*,
+    sphere_tree::{TreeCache, TreeMethod, TreeSettings},
+    teeth::Dentition,
+};
+
+fn medial() -> TreeSettings {
+    TreeSettings {
+        method: TreeMethod::Medial,
+        branching: 8,
+        depth: 4,
+    }
+}
+
+/// A tree cache private to this test process, filled with the medial trees of all 16 tooth
+/// shapes on first use (other tests wait for it rather than building the same trees again).
+fn cache() -> &'static TreeCache {
+    static CACHE: OnceLock<TreeCache> = OnceLock::new();
+    CACHE.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("orthosim-it-movement-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let cache = TreeCache::new(dir);
+        let d = Dentition::build(Case::resolve("normal").unwrap()).unwrap();
+        collision_shapes(&d, medial(), Some(&cache)).expect("trees build");
+        cache
+    })
+}
+
+fn settings(response: Response) -> MovementSettings {
+    MovementSettings {
+        step_s: 4.0 / 64.0,
+        response,
+        ..Default::default()
+    }
+}
+
+fn run(case: &str, method: Method, response: Response) -> CaseRun {
+    run_case(
+        case,
+        method,
+        settings(response),
+        medial(),
+        Some(cache()),
+        10_000,
+        |_| {},
+    )
+    .unwrap()
+}
+
+fn fdis(list: &[u8]) -> Vec<Fdi> {
+    list.iter().map(|&n| Fdi::new(n as i64).unwrap()).collect()
+}
+
+fn gap(run: &CaseRun, a: u8, b: u8) -> f32 {
+    run.report
+        .distances
+        .iter()
+        .find(|d| d.a.number() == a && d.b.number() == b)
+        .unwrap_or_else(|| panic!("no distance {a}-{b}"))
+        .surface_gap_mm
+}
+
+/// The paper's outcome for a case: who moves, who stays, at rest, no penetration beyond the
+/// method's tolerance.
+fn check_case(case: &str, method: Method, moves: &[u8], stays: &[u8]) -> CaseRun {
+    let r = run(case, method, Response::Block);
+    let rep = &r.report;
+    assert!(
+        rep.at_rest,
+        "{case} {method:?}: not at rest after {} steps",
+        rep.steps
+    );
+    for f in fdis(moves) {
+        assert!(
+            rep.moved.contains(&f),
+            "{case} {method:?}: {f} should move: {rep:?}"
+        );
+    }
+    for f in fdis(stays) {
+        assert!(
+            !rep.moved.contains(&f),
+            "{case} {method:?}: {f} should stay: {rep:?}"
+        );
+    }
+    let tolerance = match method {
+        Method::Exact => 0.01,
+        _ => 0.05,
+    };
+    assert!(
+        rep.max_penetration_mm <= tolerance,
+        "{case} {method:?}: penetration {}",
+        rep.max_penetration_mm
+    );
+    r
+}
+
+#[test]
+fn case1_moves_first_molars_and_second_premolars_not_incisors() {
+    for method in [Method::Continuous, Method::Exact] {
+        let r = check_case(
+            "case1",
+            method,
+            &[16, 26, 36, 46, 15, 25, 35, 45],
+            &[11, 12, 21, 22, 31, 32, 41, 42],
+        );
+        // The premolars were pushed into the extraction spaces, up to the canines.
+        let limit = if method == Method::Exact { 0.011 } else { 0.5 };
+        for (a, b) in [(15, 13), (23, 25), (45, 43), (33, 35)] {
+            let g = gap(&r, a, b);
+            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+        }
+        // Constrained to translate along the arch: no vertical travel.
+        for t in &r.simulation.teeth {
+            if [16, 26, 36, 46].contains(&t.fdi.number()) {
+                let dy = (t.pose.translation.y - t.initial.translation.y).abs();
+                assert!(dy < 1e-3, "{}: vertical travel {dy}", t.fdi);
+                assert!(t.displacement_mm() <= 8.0 + 1e-3);
+            }
+        }
+    }
+}
+
+#[test]
+fn case2_moves_first_molars_and_first_premolars_not_canines() {
+    for method in [Method::Continuous, Method::Exact] {
+        let r = check_case(
+            "case2",
+            method,
+            &[16, 26, 36, 46, 14, 24, 34, 44],
+            &[13, 23, 33, 43, 12, 22, 32, 42],
+        );
+        let limit = if method == Method::Exact { 0.011 } else { 0.5 };
+        for (a, b) in [(16, 14), (24, 26), (46, 44), (34, 36)] {
+            let g = gap(&r, a, b);
+            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+        }
+    }
+}
+
+#[test]
+fn case3_closes_the_diastemas() {
+    for (method, limit) in [(Method::Exact, 0.011), (Method::Continuous, 0.15)] {
+        let r = check_case("case3", method, &[11, 21, 31, 41], &[13, 23, 33, 43]);
+        for (a, b) in [(11, 21), (41, 31)] {
+            let g = gap(&r, a, b);
+            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+        }
+    }
+}
+
+#[test]
+fn circles_leave_larger_distances_than_sphere_trees() {
+    for case in ["case1", "case2"] {
+        let circles = run(case, Method::Circles, Response::Block).report;
+        let spheres = run(case, Method::Spheres, Response::Block).report;
+        let continuous = run(case, Method::Continuous, Response::Block).report;
+        assert!(
+            circles.total_centre_distance_mm > spheres.total_centre_distance_mm,
+            "{case}: circles {} spheres {}",
+            circles.total_centre_distance_mm,
+            spheres.total_centre_distance_mm
+        );
+        let (s, c) = (
+            spheres.total_centre_distance_mm,
+            continuous.total_centre_distance_mm,
+        );
+        assert!(
+            (s - c).abs() <= 0.05 * c,
+            "{case}: spheres {s} continuous {c}"
+        );
+        // Circles stop the teeth where their circles meet: space is left in front of the molars.
+        let front = |r: &orthosim::movement::SimulationReport| {
+            let pairs: &[(u8, u8)] = if case == "case1" {
+                &[(16, 15), (15, 13), (45, 43), (46, 45)]
+            } else {
+                &[(16, 14), (46, 44)]
+            };
+            r.distances
+                .iter()
+                .filter(|d| pairs.contains(&(d.a.number(), d.b.number())))
+                .map(|d| d.surface_gap_mm)
+                .sum::<f32>()
+        };
+        assert!(front(&circles) > front(&spheres) + 1.0, "{case}");
+    }
+    // Case 3: the circles of the proclined upper incisors (crown and root) overlap across the
+    // diastema, so circles cannot close it at all; the sphere trees can.
+    let circles = run("case3", Method::Circles, Response::Block);
+    let spheres = run("case3", Method::Spheres, Response::Block);
+    assert!(gap(&circles, 11, 21) > 2.0);
+    assert!(gap(&spheres, 11, 21) < 0.2);
+}
+
+#[test]
+fn the_same_run_gives_bit_identical_poses() {
+    let d = Dentition::build(Case::resolve("case1").unwrap()).unwrap();
+    let shapes = collision_shapes(&d, medial(), Some(cache())).unwrap();
+    let poses = || {
+        let mut sim = Simulation::new(
+            &d,
+            shapes.clone(),
+            Method::Continuous,
+            settings(Response::Block),
+        )
+        .unwrap();
+        for _ in 0..150 {
+            sim.step();
+        }
+        sim.teeth.iter().map(|t| t.pose).collect::<Vec<_>>()
+    };
+    let (a, b) = (poses(), poses());
+    assert!(a.iter().zip(&b).all(|(x, y)| x == y));
+    assert!(a.iter().any(|p| p.is_finite()));
+}
+
+#[test]
+fn resting_teeth_do_not_move_or_drift() {
+    // No loads: at rest at once, poses untouched.
+    let normal = run("normal", Method::Exact, Response::Block);
+    assert!(normal.report.at_rest && normal.report.steps <= 2);
+    assert!(normal.report.moved.is_empty());
+    for t in &normal.simulation.teeth {
+        assert_eq!(t.pose, t.initial, "{}", t.fdi);
+    }
+    // A case at rest stays there, with no growth of penetration.
+    let mut r = run("case3", Method::Exact, Response::Block);
+    let rest: Vec<_> = r.simulation.teeth.iter().map(|t| t.pose).collect();
+    let before = max_penetration(&r.simulation);
+    for _ in 0..500 {
+        r.simulation.step();
+    }
+    for (t, p) in r.simulation.teeth.iter().zip(&rest) {
+        assert_eq!(t.pose, *p, "{} drifted", t.fdi);
+    }
+    assert!(max_penetration(&r.simulation) <= before + 1e-6);
+}
+
+#[test]
+fn impulse_conserves_momentum_and_never_gains_energy() {
+    let d = Dentition::build(Case::resolve("case3").unwrap()).unwrap();
+    let shapes = collision_shapes(&d, medial(), Some(cache())).unwrap();
+    let settings = settings(Response::Impulse);
+    let mut sim = Simulation::new(&d, shapes, Method::Exact, settings).unwrap();
+    let mut impacts = Vec::new();
+    for _ in 0..2000 {
+        let out = sim.step();
+        impacts.extend(out.impacts.iter().cloned());
+        if out.at_rest {
+            break;
+        }
+    }
+    assert!(!impacts.is_empty(), "the incisors meet");
+    let mass = |f: Fdi| {
+        let t = sim.teeth.iter().find(|t| t.fdi == f).unwrap();
+        t.shape.geometry.frame.volume_mm3 as f32 * settings.density_kg_per_mm3
+    };
+    for i in &impacts {
+        assert!(
+            i.energy_lost_uj >= -1e-9 * i.energy_before_uj.max(1e-30),
+            "energy gained: {i:?}"
+        );
+        let (ma, mb) = (mass(i.a), mass(i.b));
+        let p0 = i.velocity_before[0] * ma + i.velocity_before[1] * mb;
+        let p1 = i.velocity_after[0] * ma + i.velocity_after[1] * mb;
+        assert!(
+            (p0 - p1).length() <= 1e-4 * p0.length().max(1e-20),
+            "momentum {p0} -> {p1}"
+        );
+    }
+    assert!(max_penetration(&sim) <= 0.011);
+}
+
+#[test]
+fn ipr_records_the_overlap_within_its_limit() {
+    let r = run("case3", Method::Continuous, Response::Ipr);
+    let limit = settings(Response::Ipr).ipr_limit_mm;
+    let upper = r.report.ipr_mm.get("11-21").copied().unwrap_or(0.0);
+    let lower = r.report.ipr_mm.get("41-31").copied().unwrap_or(0.0);
+    assert!(upper > 0.05 && lower > 0.05, "{:?}", r.report.ipr_mm);
+    // The limit holds to within one step's travel (0.03 mm per tooth here).
+    for (pair, mm) in &r.report.ipr_mm {
+        assert!(*mm <= limit + 0.07, "{pair}: {mm}");
+    }
+    assert!(r.report.max_penetration_mm <= limit + 0.07);
+    assert!(r.report.at_rest);
+}
+
+/// A headless app with the simulation plugins and a manual clock.
+fn create_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, TransformPlugin, OrthoSimPlugins))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+            16,
+        )));
+    app.finish();
+    app.cleanup();
+    app
+}
+
+#[test]
+fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
+    let mut app = create_app();
+    app.world_mut().write_message(LoadCase("case1".into()));
+    // Wait for the case and its (octree, the plugin's default) trees.
+    for _ in 0..3000 {
+        app.update();
+        if app.world().resource::<SimulationState>().sim.is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let start = app.world().resource::<MovementStatus>().steps;
+    assert!(app.world().resource::<SimulationState>().sim.is_some());
+    for _ in 0..150 {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    assert_eq!(app.world().resource::<MovementStatus>().steps, start + 150);
+    // The same steps without the ECS.
+    let d = Dentition::build(Case::resolve("case1").unwrap()).unwrap();
+    let shapes = collision_shapes(&d, TreeSettings::default(), None).unwrap();
+    let mut sim =
+        Simulation::new(&d, shapes, Method::Continuous, MovementSettings::default()).unwrap();
+    for _ in 0..start + 150 {
+        sim.step();
+    }
+    let mut q = app.world_mut().query::<(&Tooth, &Transform)>();
+    let mut checked = 0;
+    for (tooth, tf) in q.iter(app.world()) {
+        let Some(i) = sim.index_of(tooth.id) else {
+            continue;
+        };
+        let t = &sim.teeth[i];
+        assert!(
+            tf.translation.distance(t.pose.translation) < 1e-3,
+            "{}: {} vs {}",
+            tooth.id,
+            tf.translation,
+            t.pose.translation
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 28);
+    // The molar pushes the premolar into the extraction space (with the loose octree trees the
+    // molar itself follows only once the premolar has cleared its leaf spheres).
+    for n in [15, 25, 35, 45] {
+        let i = sim.index_of(Fdi::new(n).unwrap()).unwrap();
+        assert!(sim.teeth[i].displacement_mm() > 0.1, "{n}");
+    }
+}
