@@ -362,3 +362,34 @@ fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
         assert!(sim.teeth[i].displacement_mm() > 0.1, "{n}");
     }
 }
+
+/// 100,000 steps of every built-in case (continuous, block, default settings): nothing becomes
+/// NaN, teeth at rest stay bit-identical, penetration does not grow. Minutes long, so ignored;
+/// run with `cargo test --release --test it -- --ignored long_runs`.
+#[test]
+#[ignore]
+fn long_runs_stay_finite_and_at_rest() {
+    for case in ["normal", "case1", "case2", "case3"] {
+        let mut r = run_case(
+            case,
+            Method::Continuous,
+            MovementSettings::default(),
+            medial(),
+            Some(cache()),
+            100_000,
+            |_| {},
+        )
+        .unwrap();
+        assert!(r.report.at_rest, "{case}");
+        let rest: Vec<_> = r.simulation.teeth.iter().map(|t| t.pose).collect();
+        let before = max_penetration(&r.simulation);
+        while r.simulation.steps < 100_000 {
+            r.simulation.step();
+        }
+        for (t, p) in r.simulation.teeth.iter().zip(&rest) {
+            assert!(t.pose.is_finite(), "{case} {}", t.fdi);
+            assert_eq!(t.pose, *p, "{case}: {} drifted", t.fdi);
+        }
+        assert!(max_penetration(&r.simulation) <= before + 1e-6, "{case}");
+    }
+}
