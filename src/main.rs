@@ -65,6 +65,28 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run cases under every collision method and write a report: summary.json, distances.csv,
+    /// one plot per case (PNG and SVG) and index.html.
+    Report {
+        /// `all` (case1, case2, case3), a built-in case name or a path to a .ron case file.
+        #[arg(long, default_value = "all")]
+        case: String,
+        /// Folder to write into (created if needed).
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Sphere-tree builder for the simulations (depth 4, branching 8).
+        #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
+        tree: TreeMethod,
+        /// Depths of the sphere-tree fit table (octree and medial), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "3,4,5,6", value_parser = clap::value_parser!(u32).range(1..=7))]
+        fit_depths: Vec<u32>,
+        /// Most steps per run.
+        #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+        max_steps: u64,
+        /// Build every tree afresh instead of using the user's tree cache.
+        #[arg(long)]
+        no_cache: bool,
+    },
     /// Print per-tooth mesh data and exact gaps and penetrations of a case.
     Inspect {
         /// Built-in case name or path to a .ron case file.
@@ -186,6 +208,14 @@ fn main() -> ExitCode {
             settings.as_deref(),
             json,
         ),
+        Command::Report {
+            case,
+            out,
+            tree,
+            fit_depths,
+            max_steps,
+            no_cache,
+        } => run_report_command(&case, &out, tree, fit_depths, max_steps, no_cache),
         Command::Cases => {
             list_cases();
             Ok(())
@@ -379,6 +409,59 @@ fn run_simulate(
             r.impacts, r.energy_lost_uj
         );
     }
+    Ok(())
+}
+
+fn run_report_command(
+    case: &str,
+    out: &std::path::Path,
+    tree: TreeMethod,
+    fit_depths: Vec<u32>,
+    max_steps: u64,
+    no_cache: bool,
+) -> Result<()> {
+    use orthosim::analysis::{ReportOptions, report::ALL_CASES, run_report};
+    let cases = if case == "all" {
+        ALL_CASES.iter().map(|s| s.to_string()).collect()
+    } else {
+        vec![case.to_owned()]
+    };
+    let opts = ReportOptions {
+        cases,
+        trees: TreeSettings {
+            method: tree,
+            branching: 8,
+            depth: 4,
+        },
+        fit_depths,
+        cache: if no_cache {
+            None
+        } else {
+            TreeCache::user_default()
+        },
+        settings: MovementSettings::default(),
+        max_steps,
+    };
+    let progress = std::io::stderr().is_terminal();
+    let bar = |what: &str, done: usize, total: usize| {
+        if progress {
+            let filled = done * 30 / total.max(1);
+            eprint!(
+                "\r[{}{}] {done}/{total} {what:<32}",
+                "#".repeat(filled),
+                " ".repeat(30 - filled)
+            );
+            if done == total {
+                eprintln!();
+            }
+        }
+    };
+    let summary = run_report(&opts, out, &bar)?;
+    println!(
+        "wrote {} (cases: {})",
+        out.join("index.html").display(),
+        summary.cases.keys().cloned().collect::<Vec<_>>().join(", ")
+    );
     Ok(())
 }
 

@@ -376,3 +376,94 @@ fn simulate_refuses_unknown_cases_and_bad_options_in_one_line() {
     let out = orthosim(&["simulate", "--response", "bounce"]);
     assert!(!out.status.success());
 }
+
+#[test]
+fn report_writes_every_file_its_page_refers_to() {
+    let dir = std::env::temp_dir().join(format!("orthosim-report-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = orthosim(&[
+        "report",
+        "--case",
+        "case3",
+        "--out",
+        dir.to_str().unwrap(),
+        "--tree",
+        "octree",
+        "--fit-depths",
+        "3",
+        "--no-cache",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let mut refs = Vec::new();
+    for attr in ["href=\"", "src=\""] {
+        for part in html.split(attr).skip(1) {
+            refs.push(part.split('"').next().unwrap().to_owned());
+        }
+    }
+    for f in ["summary.json", "distances.csv", "case3.svg", "case3.png"] {
+        assert!(refs.iter().any(|r| r == f), "index.html refers to {f}");
+    }
+    for r in &refs {
+        let len = std::fs::metadata(dir.join(r)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 0, "{r} missing or empty");
+    }
+    let png = std::fs::read(dir.join("case3.png")).unwrap();
+    assert_eq!(&png[..4], b"\x89PNG");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for m in ["circles", "spheres", "continuous", "exact"] {
+        let a = &v["cases"]["case3"][m];
+        for key in ["total_centre_distance_mm", "max_penetration_mm", "moved"] {
+            assert!(a.get(key).is_some(), "{m}: {key}");
+        }
+    }
+    assert!(
+        v["cases"]["case3"]["exact"]["max_penetration_mm"]
+            .as_f64()
+            .unwrap()
+            <= 0.01
+    );
+    let fit = v["tree_fit"].as_array().unwrap();
+    assert_eq!(fit.len(), 2, "octree and medial at depth 3");
+    for row in fit {
+        for key in [
+            "method",
+            "depth",
+            "sov_sum_mean",
+            "sov_sum_min",
+            "sov_sum_max",
+        ] {
+            assert!(row.get(key).is_some(), "{row}");
+        }
+    }
+    for key in [
+        "anterior_ratio_pct",
+        "overall_ratio_pct",
+        "arch_length_discrepancy_upper_mm",
+    ] {
+        assert!(v["bolton"][key].is_number(), "{key}");
+    }
+    // One row per adjacent pair (15 per arch) per algorithm.
+    let csv = std::fs::read_to_string(dir.join("distances.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "case,algorithm,tooth_a,tooth_b,centre_distance_mm,surface_gap_mm"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 4 * 30);
+    for m in ["circles", "spheres", "continuous", "exact"] {
+        assert_eq!(
+            rows.iter()
+                .filter(|r| r.starts_with(&format!("case3,{m},")))
+                .count(),
+            30
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

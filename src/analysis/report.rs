@@ -1,0 +1,436 @@
+//! `orthosim report`: every case under every collision method, measured and written as JSON, CSV,
+//! plots and one self-contained HTML page. Every figure is computed by the run.
+//!
+//! Per case: a run to rest under each method (block response), the distances of its adjacent
+//! teeth, an extra run under the `ipr` response (continuous) for the interproximal reduction, and
+//! the occlusal contacts of the exact run's final poses with the bite closed again (the upper arch
+//! lowered by the case's bite opening). Once: the sphere-tree fit table (octree and medial at the
+//! asked depths, on the `normal` case) and the Bolton analysis (anatomy widths, `normal` arches).
+
+use std::{collections::BTreeMap, fmt::Write as _, path::Path};
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+use super::{
+    measures::{
+        Bolton, GAP_FLAG_MM, IprEntry, OCCLUSAL_CONTACT_MM, OcclusalContact, Posed, arch_positions,
+        bolton, ipr_entries, occlusal_contacts,
+    },
+    plot,
+};
+use crate::{
+    collision::Method,
+    geometry::Pose,
+    movement::{MovementSettings, Response, report::run_case},
+    sphere_tree::{
+        TreeCache, TreeMethod, TreeSettings,
+        report::{trees_report, write_atomic},
+    },
+    teeth::{Arch, Case, Dentition},
+};
+
+/// What a report runs.
+#[derive(Clone, Debug)]
+pub struct ReportOptions {
+    /// Case names or paths.
+    pub cases: Vec<String>,
+    /// Trees for the simulations.
+    pub trees: TreeSettings,
+    /// Depths of the fit table.
+    pub fit_depths: Vec<u32>,
+    /// Tree cache, if any.
+    pub cache: Option<TreeCache>,
+    /// Movement settings (the response is set per run).
+    pub settings: MovementSettings,
+    /// Step limit per run.
+    pub max_steps: u64,
+}
+
+/// One method's outcome on one case.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AlgorithmSummary {
+    /// Sum of adjacent centre distances (mm).
+    pub total_centre_distance_mm: f32,
+    /// Largest exact penetration at the end (mm).
+    pub max_penetration_mm: f32,
+    /// Teeth that moved more than 0.1 mm.
+    pub moved: Vec<crate::teeth::Fdi>,
+    /// Steps to rest.
+    pub steps: u64,
+    /// Came to rest.
+    pub at_rest: bool,
+    /// Sum of adjacent centre distances per arch: upper, lower (mm).
+    pub arch_centre_distance_mm: [f32; 2],
+    /// Adjacent pairs whose surface gap is above 1 mm.
+    pub gaps_over_1mm: Vec<String>,
+    /// Mean time per step (µs).
+    pub step_us: f64,
+}
+
+/// A row of the sphere-tree fit table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FitRow {
+    /// Builder.
+    pub method: TreeMethod,
+    /// Levels including the root.
+    pub depth: u32,
+    /// Mean relative outside volume.
+    pub sov_sum_mean: f64,
+    /// Least.
+    pub sov_sum_min: f64,
+    /// Largest.
+    pub sov_sum_max: f64,
+    /// Mean leaves per tooth.
+    pub leaves_mean: f64,
+    /// Every tree covers its tooth.
+    pub all_covered: bool,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// Per case, per method.
+    pub cases: BTreeMap<String, BTreeMap<String, AlgorithmSummary>>,
+    /// Sphere-tree fit.
+    pub tree_fit: Vec<FitRow>,
+    /// Bolton analysis of the anatomy's widths and the normal arches.
+    pub bolton: Bolton,
+    /// IPR per contact under the `ipr` response, per case.
+    pub ipr: BTreeMap<String, Vec<IprEntry>>,
+    /// Occlusal contacts per tooth at the end of the exact run with the bite closed, per case.
+    pub occlusion: BTreeMap<String, Vec<OcclusalContact>>,
+}
+
+/// A row of `distances.csv`.
+struct DistanceRow {
+    case: String,
+    algorithm: &'static str,
+    a: u8,
+    b: u8,
+    centre: f32,
+    gap: f32,
+}
+
+/// The built-in treatment cases (`--case all`).
+pub const ALL_CASES: [&str; 3] = ["case1", "case2", "case3"];
+
+/// Runs the report and writes its files into `out` (created if needed). `progress(what, done,
+/// total)` is called as work finishes.
+pub fn run_report(
+    opts: &ReportOptions,
+    out: &Path,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<Summary> {
+    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    let total = opts.cases.len() * (Method::ALL.len() + 1) + 2 * opts.fit_depths.len();
+    let mut done = 0;
+    let mut cases = BTreeMap::new();
+    let mut rows = Vec::new();
+    let mut ipr = BTreeMap::new();
+    let mut occlusion = BTreeMap::new();
+    let mut plots = Vec::new();
+    for case in &opts.cases {
+        let loaded = Case::resolve(case)?;
+        let name = loaded.case.name.clone();
+        let opening = loaded.case.bite_opening_mm.0;
+        let mut per_method = BTreeMap::new();
+        let mut series_data = Vec::new();
+        let mut labels = Vec::new();
+        for method in Method::ALL {
+            progress(&format!("{name} {}", method.name()), done, total);
+            let settings = MovementSettings {
+                response: Response::Block,
+                ..opts.settings
+            };
+            let run = run_case(
+                case,
+                method,
+                settings,
+                opts.trees,
+                opts.cache.as_ref(),
+                opts.max_steps,
+                |_| {},
+            )?;
+            done += 1;
+            let r = &run.report;
+            let mut arch_total = [0.0f32; 2];
+            for d in &r.distances {
+                let k = if d.a.arch() == Arch::Upper { 0 } else { 1 };
+                arch_total[k] += d.centre_distance_mm;
+                rows.push(DistanceRow {
+                    case: name.clone(),
+                    algorithm: method.name(),
+                    a: d.a.number(),
+                    b: d.b.number(),
+                    centre: d.centre_distance_mm,
+                    gap: d.surface_gap_mm,
+                });
+            }
+            labels = r
+                .distances
+                .iter()
+                .map(|d| format!("{}-{}", d.a, d.b))
+                .collect();
+            series_data.push((
+                method.name(),
+                r.distances
+                    .iter()
+                    .map(|d| d.centre_distance_mm)
+                    .collect::<Vec<_>>(),
+                r.distances
+                    .iter()
+                    .map(|d| d.surface_gap_mm)
+                    .collect::<Vec<_>>(),
+            ));
+            per_method.insert(
+                method.name().to_owned(),
+                AlgorithmSummary {
+                    total_centre_distance_mm: r.total_centre_distance_mm,
+                    max_penetration_mm: r.max_penetration_mm,
+                    moved: r.moved.clone(),
+                    steps: r.steps,
+                    at_rest: r.at_rest,
+                    arch_centre_distance_mm: arch_total,
+                    gaps_over_1mm: r
+                        .distances
+                        .iter()
+                        .filter(|d| d.surface_gap_mm > GAP_FLAG_MM)
+                        .map(|d| format!("{}-{}", d.a, d.b))
+                        .collect(),
+                    step_us: r.step_us,
+                },
+            );
+            if method == Method::Exact {
+                let teeth: Vec<Posed> = run
+                    .simulation
+                    .teeth
+                    .iter()
+                    .map(|t| Posed {
+                        fdi: t.fdi,
+                        geometry: &t.shape.geometry,
+                        pose: if t.fdi.arch() == Arch::Upper {
+                            Pose::new(
+                                t.pose.rotation,
+                                t.pose.translation - glam::Vec3::Y * opening,
+                            )
+                        } else {
+                            t.pose
+                        },
+                    })
+                    .collect();
+                occlusion.insert(name.clone(), occlusal_contacts(&teeth, OCCLUSAL_CONTACT_MM));
+            }
+        }
+        progress(&format!("{name} ipr"), done, total);
+        let settings = MovementSettings {
+            response: Response::Ipr,
+            ..opts.settings
+        };
+        let run = run_case(
+            case,
+            Method::Continuous,
+            settings,
+            opts.trees,
+            opts.cache.as_ref(),
+            opts.max_steps,
+            |_| {},
+        )?;
+        done += 1;
+        ipr.insert(
+            name.clone(),
+            ipr_entries(run.simulation.ipr.iter().map(|((a, b), mm)| (*a, *b, *mm))),
+        );
+        let series: Vec<plot::Series> = series_data
+            .iter()
+            .map(|(n, c, g)| plot::Series {
+                name: n,
+                centre: c.clone(),
+                gap: g.clone(),
+            })
+            .collect();
+        let title = format!("{name}: adjacent teeth at rest, per algorithm");
+        let svg = plot::svg(&title, &labels, &series).map_err(|e| anyhow::anyhow!("{e}"))?;
+        write_atomic(&out.join(format!("{name}.svg")), &svg)?;
+        plot::png(&out.join(format!("{name}.png")), &title, &labels, &series)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        plots.push(name.clone());
+        cases.insert(name, per_method);
+    }
+    let normal = Dentition::build(Case::resolve("normal")?)?;
+    let mut tree_fit = Vec::new();
+    for method in [TreeMethod::Octree, TreeMethod::Medial] {
+        for &depth in &opts.fit_depths {
+            progress(&format!("trees {method:?} depth {depth}"), done, total);
+            let settings = TreeSettings {
+                method,
+                branching: 8,
+                depth,
+            };
+            let (r, _) = trees_report(&normal, settings, opts.cache.as_ref(), &|_, _| {})?;
+            done += 1;
+            tree_fit.push(FitRow {
+                method,
+                depth,
+                sov_sum_mean: r.summary.sov_sum_mean,
+                sov_sum_min: r.summary.sov_sum_min,
+                sov_sum_max: r.summary.sov_sum_max,
+                leaves_mean: r.summary.leaves_mean,
+                all_covered: r.summary.all_covered,
+            });
+        }
+    }
+    progress("writing", done, total);
+    let posed: Vec<Posed> = normal
+        .visible()
+        .map(|t| Posed {
+            fdi: t.fdi,
+            geometry: &t.geometry,
+            pose: t.pose,
+        })
+        .collect();
+    let arches = arch_positions(&posed);
+    let width = |f| {
+        normal
+            .tooth(f)
+            .map_or(f32::NAN, |t| t.geometry.anatomy.mesiodistal)
+    };
+    let summary = Summary {
+        cases,
+        tree_fit,
+        bolton: bolton(width, [&arches[0], &arches[1]]),
+        ipr,
+        occlusion,
+    };
+    write_atomic(
+        &out.join("summary.json"),
+        &serde_json::to_string_pretty(&summary)?,
+    )?;
+    let mut csv =
+        String::from("case,algorithm,tooth_a,tooth_b,centre_distance_mm,surface_gap_mm\n");
+    for r in &rows {
+        writeln!(
+            csv,
+            "{},{},{},{},{:.4},{:.4}",
+            r.case, r.algorithm, r.a, r.b, r.centre, r.gap
+        )?;
+    }
+    write_atomic(&out.join("distances.csv"), &csv)?;
+    write_atomic(&out.join("index.html"), &html(&summary, &plots))?;
+    progress("done", total, total);
+    Ok(summary)
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The self-contained page: tables and the plots (SVG inline-referenced files beside it).
+fn html(s: &Summary, plots: &[String]) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>orthosim report</title>\
+<style>body{{font-family:sans-serif;margin:2em;max-width:1200px}}table{{border-collapse:collapse;margin:1em 0}}\
+td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}th{{background:#eee}}\
+td.l,th.l{{text-align:left}}img{{max-width:100%;border:1px solid #ddd}}</style></head><body>\n\
+<h1>orthosim report</h1>\n<p>Every figure below was computed by this run. Raw data: \
+<a href=\"summary.json\">summary.json</a>, <a href=\"distances.csv\">distances.csv</a>.</p>\n"
+    );
+    h.push_str("<h2>Cases</h2>\n<table><tr><th class=\"l\">case</th><th class=\"l\">algorithm</th><th>steps</th><th>at rest</th><th class=\"l\">moved (&gt; 0.1 mm)</th><th>total centre distance mm</th><th>upper / lower mm</th><th>max penetration mm</th><th class=\"l\">gaps &gt; 1 mm</th><th>µs per step</th></tr>\n");
+    for (case, methods) in &s.cases {
+        for (m, a) in methods {
+            let moved: Vec<String> = a.moved.iter().map(|f| f.to_string()).collect();
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{}</td><td class=\"l\">{}</td><td>{:.3}</td><td>{:.3} / {:.3}</td><td>{:.4}</td><td class=\"l\">{}</td><td>{:.0}</td></tr>",
+                escape(case),
+                m,
+                a.steps,
+                a.at_rest,
+                moved.join(" "),
+                a.total_centre_distance_mm,
+                a.arch_centre_distance_mm[0],
+                a.arch_centre_distance_mm[1],
+                a.max_penetration_mm,
+                a.gaps_over_1mm.join(" "),
+                a.step_us
+            );
+        }
+    }
+    h.push_str("</table>\n");
+    for p in plots {
+        let _ = writeln!(
+            h,
+            "<h3>{0}</h3>\n<p><img src=\"{0}.svg\" alt=\"{0}: distances per adjacent pair\"> \
+<br><a href=\"{0}.png\">PNG</a> · <a href=\"{0}.svg\">SVG</a></p>",
+            escape(p)
+        );
+    }
+    h.push_str("<h2>Sphere-tree fit (relative outside volume, the paper's measure; branching 8)</h2>\n<table><tr><th class=\"l\">builder</th><th>depth</th><th>mean</th><th>min</th><th>max</th><th>leaves (mean)</th><th>covered</th></tr>\n");
+    for r in &s.tree_fit {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{:?}</td><td>{}</td><td>{:.3}</td><td>{:.3}</td><td>{:.3}</td><td>{:.0}</td><td>{}</td></tr>",
+            r.method,
+            r.depth,
+            r.sov_sum_mean,
+            r.sov_sum_min,
+            r.sov_sum_max,
+            r.leaves_mean,
+            r.all_covered
+        );
+    }
+    h.push_str("</table>\n<p>The paper: Bradshaw's trees (4 levels) mean 0.16 (0.07–0.51); octree (6 levels) mean 1.25 (0.89–2.12).</p>\n");
+    let b = &s.bolton;
+    let _ = write!(
+        h,
+        "<h2>Bolton analysis and arch length</h2>\n<table>\
+<tr><th class=\"l\">anterior ratio</th><td>{:.1} % (norm {:.1} %, mandibular excess {:+.2} mm)</td></tr>\
+<tr><th class=\"l\">overall ratio</th><td>{:.1} % (norm {:.1} %, mandibular excess {:+.2} mm)</td></tr>\
+<tr><th class=\"l\">arch-length discrepancy, upper</th><td>{:+.2} mm</td></tr>\
+<tr><th class=\"l\">arch-length discrepancy, lower</th><td>{:+.2} mm</td></tr></table>\n",
+        b.anterior_ratio_pct,
+        b.anterior_norm_pct,
+        b.anterior_excess_mm,
+        b.overall_ratio_pct,
+        b.overall_norm_pct,
+        b.overall_excess_mm,
+        b.arch_length_discrepancy_upper_mm,
+        b.arch_length_discrepancy_lower_mm
+    );
+    h.push_str("<h2>Interproximal reduction (ipr response)</h2>\n<table><tr><th class=\"l\">case</th><th class=\"l\">contact</th><th>IPR mm</th><th class=\"l\">over 0.5 mm per contact</th><th class=\"l\">over 0.25 mm per surface</th></tr>\n");
+    for (case, list) in &s.ipr {
+        for e in list {
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}-{}</td><td>{:.3}</td><td class=\"l\">{}</td><td class=\"l\">{}</td></tr>",
+                escape(case),
+                e.a,
+                e.b,
+                e.ipr_mm,
+                e.over_contact_limit,
+                e.over_surface_limit
+            );
+        }
+    }
+    h.push_str("</table>\n<h2>Occlusal contacts (exact run, bite closed; surface within 0.05 mm of the opposing arch)</h2>\n<table><tr><th class=\"l\">case</th><th class=\"l\">tooth</th><th>area mm²</th><th>least gap mm</th><th class=\"l\">antagonists</th></tr>\n");
+    for (case, list) in &s.occlusion {
+        for c in list.iter().filter(|c| c.area_mm2 > 0.0) {
+            let ants: Vec<String> = c.antagonists.iter().map(|f| f.to_string()).collect();
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{:.3}</td><td class=\"l\">{}</td></tr>",
+                escape(case),
+                c.fdi,
+                c.area_mm2,
+                c.min_gap_mm.unwrap_or(f32::NAN),
+                ants.join(" ")
+            );
+        }
+    }
+    h.push_str("</table>\n</body></html>\n");
+    h
+}
