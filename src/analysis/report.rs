@@ -254,7 +254,7 @@ pub fn run_report(
         write_atomic(&out.join(format!("{name}.svg")), &svg)?;
         plot::png(&out.join(format!("{name}.png")), &title, &labels, &series)
             .map_err(|e| anyhow::anyhow!("{e}"))?;
-        plots.push(name.clone());
+        plots.push((name.clone(), svg));
         cases.insert(name, per_method);
     }
     let normal = Dentition::build(Case::resolve("normal")?)?;
@@ -327,15 +327,15 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The self-contained page: tables and the plots (SVG inline-referenced files beside it).
-fn html(s: &Summary, plots: &[String]) -> String {
+/// The self-contained page: tables and the plots inlined as SVG (the files beside it are linked).
+fn html(s: &Summary, plots: &[(String, String)]) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>orthosim report</title>\
 <style>body{{font-family:sans-serif;margin:2em;max-width:1200px}}table{{border-collapse:collapse;margin:1em 0}}\
 td,th{{border:1px solid #bbb;padding:3px 8px;text-align:right}}th{{background:#eee}}\
-td.l,th.l{{text-align:left}}img{{max-width:100%;border:1px solid #ddd}}</style></head><body>\n\
+td.l,th.l{{text-align:left}}figure svg{{max-width:100%;height:auto;border:1px solid #ddd}}</style></head><body>\n\
 <h1>orthosim report</h1>\n<p>Every figure below was computed by this run. Raw data: \
 <a href=\"summary.json\">summary.json</a>, <a href=\"distances.csv\">distances.csv</a>.</p>\n"
     );
@@ -361,12 +361,16 @@ td.l,th.l{{text-align:left}}img{{max-width:100%;border:1px solid #ddd}}</style><
         }
     }
     h.push_str("</table>\n");
-    for p in plots {
+    for (p, svg) in plots {
+        // The SVG is inlined (its XML declaration dropped) so the page stands alone.
+        let body = svg.find("<svg").map_or(svg.as_str(), |i| &svg[i..]);
         let _ = writeln!(
             h,
-            "<h3>{0}</h3>\n<p><img src=\"{0}.svg\" alt=\"{0}: distances per adjacent pair\"> \
-<br><a href=\"{0}.png\">PNG</a> · <a href=\"{0}.svg\">SVG</a></p>",
-            escape(p)
+            "<h3>{0}</h3>\n<figure>{1}<figcaption>{0}: centre distance and surface gap per \
+adjacent pair, one series per algorithm. <a href=\"{0}.png\">PNG</a> · \
+<a href=\"{0}.svg\">SVG</a></figcaption></figure>",
+            escape(p),
+            body
         );
     }
     h.push_str("<h2>Sphere-tree fit (relative outside volume, the paper's measure; branching 8)</h2>\n<table><tr><th class=\"l\">builder</th><th>depth</th><th>mean</th><th>min</th><th>max</th><th>leaves (mean)</th><th>covered</th></tr>\n");
