@@ -14,7 +14,9 @@ pub mod settings;
 pub mod sim;
 
 pub use model::ToothConstraint;
-pub use plugin::{MovementPlugin, MovementStatus, SetLoad, SimulationState};
+pub use plugin::{
+    MovementPlugin, MovementStatus, SetGroupLoad, SetLoad, SimulationState, ToothImpact,
+};
 pub use report::{PairDistance, SimulationReport, run_case};
 pub use settings::{MovementSettings, Response};
 pub use sim::{Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome};

@@ -63,6 +63,15 @@ pub struct SetLoad {
     pub load: Load,
 }
 
+/// Set a group's load from code (the group's index in the case's group loads).
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SetGroupLoad {
+    /// Index of the group.
+    pub group: usize,
+    /// Its new load (world frame).
+    pub load: Load,
+}
+
 /// An impact of the `impulse` response.
 #[derive(Message, Clone, Debug, PartialEq, Deref)]
 pub struct ToothImpact(pub Impact);
@@ -87,6 +96,7 @@ impl Plugin for MovementPlugin {
             .init_resource::<SimulationState>()
             .init_resource::<MovementStatus>()
             .add_message::<SetLoad>()
+            .add_message::<SetGroupLoad>()
             .add_message::<ToothImpact>()
             .add_systems(
                 self.schedule,
@@ -172,13 +182,23 @@ fn start_simulation(
 fn apply_loads(
     mut state: ResMut<SimulationState>,
     mut messages: MessageReader<SetLoad>,
+    mut group_messages: MessageReader<SetGroupLoad>,
     mut loads: Query<(Entity, &mut Load), Without<Extracted>>,
 ) {
     let state = &mut *state;
     let Some(sim) = state.sim.as_mut() else {
         messages.clear();
+        group_messages.clear();
         return;
     };
+    for m in group_messages.read() {
+        let finite = m.load.force.is_finite() && m.load.torque.is_finite();
+        match sim.groups.get_mut(m.group) {
+            Some(g) if finite => g.load = m.load,
+            Some(_) => warn!("ignored a group load with non-finite components"),
+            None => warn!("ignored a load for group {}: no such group", m.group),
+        }
+    }
     for m in messages.read() {
         if !(m.load.force.is_finite() && m.load.torque.is_finite()) {
             warn!("ignored a load with non-finite components");

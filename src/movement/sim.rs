@@ -28,9 +28,12 @@
 //!   [`MovementSettings::ipr_limit_mm`] blocks (the step is undone), as do contacts between the
 //!   arches.
 //!
-//! A contact already touching at the start of the step blocks only if the teeth approach each
-//! other there (relative velocity of the contact points along the normal, or of the overlapping
-//! leaf spheres' centres), so teeth can always move apart. With `circles`, pairs of opposite
+//! A contact already touching at the start of the step blocks only if the teeth close in on each
+//! other, so teeth can always move apart or slide along each other: with `exact` when the contact
+//! points approach along the normal or the meshes overlap deeper at the end of the step than at
+//! its start; with `continuous` when the deepest overlap of leaf spheres grows over the step (leaf
+//! spheres of neighbours overlap at rest, and some pair of them approaches under almost any
+//! motion); with the discrete methods when an overlapping leaf pair (or the circles) got closer. With `circles`, pairs of opposite
 //! arches never block: the paper's circles ignore height and would lock every tooth against its
 //! antagonist.
 //!
@@ -672,7 +675,14 @@ impl Simulation {
                 if t >= 1.0 - TIME_SLACK {
                     None
                 } else if t <= 1e-6 {
-                    (self.closing(f, t) || self.deepens(f)).then_some(0.0)
+                    // Continuous: leaf spheres overlap at rest, and some pair of them approaches
+                    // under almost any motion, so only a deepening overlap blocks (sliding along a
+                    // neighbour is free). Exact: approaching contact points, or deeper overlap.
+                    let blocks = match self.method {
+                        Method::Continuous => self.deepens(f),
+                        _ => self.closing(f, t) || self.deepens(f),
+                    };
+                    blocks.then_some(0.0)
                 } else {
                     Some(t)
                 }

@@ -393,3 +393,61 @@ fn long_runs_stay_finite_and_at_rest() {
         assert!(max_penetration(&r.simulation) <= before + 1e-6, "{case}");
     }
 }
+
+#[test]
+fn a_load_set_by_message_moves_its_tooth() {
+    use orthosim::movement::{SetGroupLoad, SetLoad};
+    let mut app = create_app();
+    app.world_mut().write_message(LoadCase("normal".into()));
+    for _ in 0..3000 {
+        app.update();
+        if app.world().resource::<SimulationState>().sim.is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let mut q = app.world_mut().query::<(Entity, &Tooth, &Transform)>();
+    let (e11, before) = q
+        .iter(app.world())
+        .find(|(_, t, _)| t.id.number() == 11)
+        .map(|(e, _, tf)| (e, *tf))
+        .unwrap();
+    for _ in 0..10 {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    assert_eq!(
+        *app.world().get::<Transform>(e11).unwrap(),
+        before,
+        "no load, no motion"
+    );
+    // Labial (+z at the front) 1.5 N: the incisor moves out of the arch.
+    app.world_mut().write_message(SetLoad {
+        tooth: e11,
+        load: Load {
+            force: Vec3::new(0.0, 0.0, 1.5),
+            torque: Vec3::ZERO,
+        },
+    });
+    // A load for a group that does not exist, or with NaN, is refused without harm.
+    app.world_mut().write_message(SetGroupLoad {
+        group: 7,
+        load: Load::default(),
+    });
+    app.world_mut().write_message(SetLoad {
+        tooth: e11,
+        load: Load {
+            force: Vec3::NAN,
+            torque: Vec3::ZERO,
+        },
+    });
+    for _ in 0..20 {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    let after = *app.world().get::<Transform>(e11).unwrap();
+    let moved = after.translation - before.translation;
+    assert!(moved.z > 0.05 && moved.is_finite(), "{moved}");
+    assert_eq!(
+        app.world().get::<Load>(e11).unwrap().force,
+        Vec3::new(0.0, 0.0, 1.5)
+    );
+}
