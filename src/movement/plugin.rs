@@ -34,6 +34,9 @@ pub struct SimulationState {
     pub entities: Vec<Entity>,
     /// The case it was made for.
     case: Option<Arc<Dentition>>,
+    /// This step is skipped (some tooth does not carry its `ToothMotion` yet, so the collision
+    /// stage could not see the motions).
+    skip: bool,
 }
 
 impl SimulationState {
@@ -236,6 +239,11 @@ fn write_motions(state: &SimulationState, motions: &mut Query<&mut ToothMotion>)
 }
 
 fn propose(mut state: ResMut<SimulationState>, mut motions: Query<&mut ToothMotion>) {
+    let ready = state.entities.iter().all(|e| motions.contains(*e));
+    state.skip = !ready;
+    if !ready {
+        return;
+    }
     if let Some(sim) = state.sim.as_mut() {
         sim.propose();
     }
@@ -248,6 +256,9 @@ fn resolve(
     mut motions: Query<&mut ToothMotion>,
 ) {
     let state_ref = &mut *state;
+    if state_ref.skip {
+        return;
+    }
     let Some(sim) = state_ref.sim.as_mut() else {
         return;
     };
@@ -291,6 +302,9 @@ fn commit(
     mut impacts: MessageWriter<ToothImpact>,
 ) {
     let state_ref = &mut *state;
+    if state_ref.skip {
+        return;
+    }
     let Some(sim) = state_ref.sim.as_mut() else {
         return;
     };
