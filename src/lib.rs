@@ -15,6 +15,7 @@
 //! | [`collision::CollisionPlugin`] | [`collision`] | broad and narrow phases, contacts of moving teeth |
 //! | [`movement::MovementPlugin`] | [`movement`] | loads, wire models, motion per step, block / impulse / IPR responses |
 //! | `OcclusionViewPlugin` (feature `viewer`) | `occlusion_view` | rendering, orbit camera |
+//! | `OrthoSimUiPlugin` (feature `viewer`) | `ui` | the egui control panel and readouts |
 
 //!
 //! [`OrthoSimPlugins`] adds every simulation plugin; the viewer is added separately so the
@@ -29,6 +30,8 @@ pub mod occlusion_view;
 pub mod parallel;
 pub mod sphere_tree;
 pub mod teeth;
+#[cfg(feature = "viewer")]
+pub mod ui;
 
 use bevy::{app::PluginGroupBuilder, prelude::*};
 

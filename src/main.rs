@@ -35,6 +35,25 @@ enum Command {
         #[arg(long, value_enum, default_value_t = orthosim::occlusion_view::CameraPreset::Frontal)]
         camera: orthosim::occlusion_view::CameraPreset,
     },
+    /// Open the real window, simulate a case for some frames and save a screenshot (PNG).
+    Screenshot {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "normal")]
+        case: String,
+        /// Camera view.
+        #[cfg(feature = "viewer")]
+        #[arg(long, value_enum, default_value_t = orthosim::occlusion_view::CameraPreset::Frontal)]
+        view: orthosim::occlusion_view::CameraPreset,
+        /// Frames to run once the simulation is ready (trees built).
+        #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+        frames: u32,
+        /// Sphere-tree builder (depth 4, branching 8; medial from the user's tree cache).
+        #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
+        tree: TreeMethod,
+        /// The PNG file to write.
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// List the built-in cases, one line each.
     Cases,
     /// Run a case headless until the teeth come to rest and report where they went.
@@ -216,6 +235,16 @@ fn main() -> ExitCode {
             max_steps,
             no_cache,
         } => run_report_command(&case, &out, tree, fit_depths, max_steps, no_cache),
+        #[cfg(feature = "viewer")]
+        Command::Screenshot {
+            case,
+            view,
+            frames,
+            tree,
+            out,
+        } => screenshot(&case, view, frames, tree, &out),
+        #[cfg(not(feature = "viewer"))]
+        Command::Screenshot { .. } => view("none"),
         Command::Cases => {
             list_cases();
             Ok(())
@@ -616,29 +645,77 @@ fn run_trees(
 
 #[cfg(feature = "viewer")]
 fn view(case: &str, camera: orthosim::occlusion_view::CameraPreset) -> Result<()> {
-    use bevy::prelude::*;
-    use orthosim::{OrthoSimPlugins, occlusion_view::OcclusionViewPlugin, teeth::TeethModelPlugin};
+    use orthosim::occlusion_view::OcclusionViewPlugin;
     // Fail early, with the file position, before a window opens.
     Case::resolve(case)?;
-    App::new()
-        .add_plugins(DefaultPlugins.set(WindowPlugin {
-            primary_window: Some(Window {
-                title: format!("orthosim: {case}"),
-                ..default()
-            }),
-            ..default()
-        }))
-        .add_plugins(OrthoSimPlugins.set(TeethModelPlugin {
-            initial_case: Some(case.to_owned()),
-        }))
-        .insert_resource(orthosim::sphere_tree::SphereTreeCache(
-            TreeCache::user_default(),
-        ))
+    window_app(case, format!("orthosim: {case}"), TreeMethod::Medial)
         .add_plugins(OcclusionViewPlugin {
             initial_view: camera,
         })
+        .add_plugins(orthosim::ui::OrthoSimUiPlugin)
         .run();
     Ok(())
+}
+
+/// The simulation and view plugins of the window commands, trees medial from the user's cache.
+#[cfg(feature = "viewer")]
+fn window_app(case: &str, title: String, tree: TreeMethod) -> bevy::prelude::App {
+    use bevy::prelude::*;
+    use orthosim::{
+        OrthoSimPlugins,
+        sphere_tree::{SphereTreeCache, SphereTreeSettings},
+        teeth::TeethModelPlugin,
+    };
+    let mut app = App::new();
+    app.add_plugins(DefaultPlugins.set(WindowPlugin {
+        primary_window: Some(Window { title, ..default() }),
+        ..default()
+    }))
+    .add_plugins(OrthoSimPlugins.set(TeethModelPlugin {
+        initial_case: Some(case.to_owned()),
+    }))
+    .insert_resource(SphereTreeCache(TreeCache::user_default()))
+    .insert_resource(SphereTreeSettings(TreeSettings {
+        method: tree,
+        branching: 8,
+        depth: 4,
+    }));
+    app
+}
+
+#[cfg(feature = "viewer")]
+fn screenshot(
+    case: &str,
+    camera: orthosim::occlusion_view::CameraPreset,
+    frames: u32,
+    tree: TreeMethod,
+    out: &std::path::Path,
+) -> Result<()> {
+    use orthosim::occlusion_view::{OcclusionViewPlugin, ScreenshotOutcome, ScreenshotPlugin};
+    Case::resolve(case)?;
+    if out.extension().and_then(|e| e.to_str()) != Some("png") {
+        anyhow::bail!("{}: the screenshot must be a .png file", out.display());
+    }
+    let shared = std::sync::Arc::new(std::sync::Mutex::new(ScreenshotOutcome::default()));
+    let mut app = window_app(case, format!("orthosim: {case}"), tree);
+    app.add_plugins(OcclusionViewPlugin {
+        initial_view: camera,
+    })
+    .add_plugins(ScreenshotPlugin {
+        path: out.to_owned(),
+        frames,
+        outcome: shared.clone(),
+    });
+    app.run();
+    let outcome = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    match outcome.error {
+        Some(e) => anyhow::bail!("{e}"),
+        None if outcome.written => {
+            println!("wrote {}", out.display());
+            Ok(())
+        }
+        None => anyhow::bail!("the window closed before the screenshot was taken"),
+    }
 }
 
 #[cfg(not(feature = "viewer"))]

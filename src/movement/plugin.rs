@@ -55,7 +55,13 @@ pub struct MovementStatus {
     pub moved: usize,
     /// Nothing moves any more.
     pub at_rest: bool,
+    /// Time of the last step's broad phase, narrow phase and response (µs).
+    pub collision_us: f64,
 }
+
+/// When the last step's collision stage started.
+#[derive(Resource, Default)]
+struct CollisionClock(Option<std::time::Instant>);
 
 /// Set a tooth's load from code (replaces its own load).
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -98,6 +104,7 @@ impl Plugin for MovementPlugin {
         app.init_resource::<MovementSettings>()
             .init_resource::<SimulationState>()
             .init_resource::<MovementStatus>()
+            .init_resource::<CollisionClock>()
             .add_message::<SetLoad>()
             .add_message::<SetGroupLoad>()
             .add_message::<ToothImpact>()
@@ -107,6 +114,9 @@ impl Plugin for MovementPlugin {
                     start_simulation.before(SimulationSystems::Loads),
                     apply_loads.in_set(SimulationSystems::Loads),
                     propose.in_set(SimulationSystems::Motion),
+                    start_clock
+                        .after(SimulationSystems::Motion)
+                        .before(SimulationSystems::BroadPhase),
                     resolve.in_set(SimulationSystems::Resolve),
                     commit.in_set(SimulationSystems::Commit),
                 ),
@@ -294,9 +304,14 @@ fn resolve(
     write_motions(&state, &mut motions);
 }
 
+fn start_clock(mut clock: ResMut<CollisionClock>) {
+    clock.0 = Some(std::time::Instant::now());
+}
+
 fn commit(
     mut state: ResMut<SimulationState>,
     mut status: ResMut<MovementStatus>,
+    clock: Res<CollisionClock>,
     mut transforms: Query<&mut Transform, With<Tooth>>,
     mut motions: Query<&mut ToothMotion>,
     mut impacts: MessageWriter<ToothImpact>,
@@ -308,6 +323,7 @@ fn commit(
     let Some(sim) = state_ref.sim.as_mut() else {
         return;
     };
+    let collision_us = clock.0.map_or(0.0, |t| t.elapsed().as_secs_f64() * 1e6);
     sim.commit();
     for (e, t) in state_ref.entities.iter().zip(&sim.teeth) {
         if let Ok(mut tf) = transforms.get_mut(*e)
@@ -329,6 +345,7 @@ fn commit(
         steps: sim.steps,
         moved: sim.last.moved,
         at_rest: sim.last.at_rest,
+        collision_us,
     };
     if *status != new {
         *status = new;

@@ -3,11 +3,13 @@
 //! It only adds viewing: the simulation plugins run the same with or without it.
 
 mod camera;
+pub mod screenshot;
 mod tooth_render;
 
 use bevy::prelude::*;
 
 pub use camera::{CameraPreset, OrbitCamera};
+pub use screenshot::{ScreenshotOutcome, ScreenshotPlugin};
 
 /// Renders the arches with lit, tooth-coloured materials and an orbit/pan/zoom camera.
 ///
@@ -36,7 +38,7 @@ impl Plugin for OcclusionViewPlugin {
                     tooth_render::attach_tooth_meshes,
                     tooth_render::hide_extracted,
                     camera::camera_presets,
-                    camera::orbit_camera,
+                    camera::orbit_camera.run_if(crate::ui::pointer_free),
                 )
                     .chain(),
             );

@@ -8,3 +8,4 @@ mod movement;
 mod oracle;
 mod parry_support;
 mod teeth;
+mod window;
