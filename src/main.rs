@@ -50,6 +50,11 @@ enum Command {
         /// Sphere-tree builder (depth 4, branching 8; medial from the user's tree cache).
         #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
         tree: TreeMethod,
+        /// Overlays: `spheres:LEVEL` (a sphere-tree level, 0 = root) or `contacts` (overlapping
+        /// leaf spheres and contact points of the step); repeat for several.
+        #[cfg(feature = "viewer")]
+        #[arg(long)]
+        overlay: Vec<orthosim::occlusion_view::Overlay>,
         /// The PNG file to write.
         #[arg(long)]
         out: std::path::PathBuf,
@@ -241,8 +246,9 @@ fn main() -> ExitCode {
             view,
             frames,
             tree,
+            overlay,
             out,
-        } => screenshot(&case, view, frames, tree, &out),
+        } => screenshot(&case, view, frames, tree, &overlay, &out),
         #[cfg(not(feature = "viewer"))]
         Command::Screenshot { .. } => view("none"),
         Command::Cases => {
@@ -651,6 +657,7 @@ fn view(case: &str, camera: orthosim::occlusion_view::CameraPreset) -> Result<()
     window_app(case, format!("orthosim: {case}"), TreeMethod::Medial)
         .add_plugins(OcclusionViewPlugin {
             initial_view: camera,
+            ..Default::default()
         })
         .add_plugins(orthosim::ui::OrthoSimUiPlugin)
         .run();
@@ -689,6 +696,7 @@ fn screenshot(
     camera: orthosim::occlusion_view::CameraPreset,
     frames: u32,
     tree: TreeMethod,
+    overlays: &[orthosim::occlusion_view::Overlay],
     out: &std::path::Path,
 ) -> Result<()> {
     use orthosim::occlusion_view::{OcclusionViewPlugin, ScreenshotOutcome, ScreenshotPlugin};
@@ -700,6 +708,10 @@ fn screenshot(
     let mut app = window_app(case, format!("orthosim: {case}"), tree);
     app.add_plugins(OcclusionViewPlugin {
         initial_view: camera,
+        overlays: overlays.iter().fold(
+            Default::default(),
+            |o: orthosim::occlusion_view::Overlays, x| o.with(*x),
+        ),
     })
     .add_plugins(ScreenshotPlugin {
         path: out.to_owned(),

@@ -3,12 +3,14 @@
 //! It only adds viewing: the simulation plugins run the same with or without it.
 
 mod camera;
+pub mod overlays;
 pub mod screenshot;
 mod tooth_render;
 
 use bevy::prelude::*;
 
 pub use camera::{CameraPreset, OrbitCamera};
+pub use overlays::{Overlay, Overlays};
 pub use screenshot::{ScreenshotOutcome, ScreenshotPlugin};
 
 /// Renders the arches with lit, tooth-coloured materials and an orbit/pan/zoom camera.
@@ -19,12 +21,15 @@ pub use screenshot::{ScreenshotOutcome, ScreenshotPlugin};
 pub struct OcclusionViewPlugin {
     /// The camera view at start-up.
     pub initial_view: CameraPreset,
+    /// Overlays shown at start-up.
+    pub overlays: Overlays,
 }
 
 impl Plugin for OcclusionViewPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<tooth_render::ToothRenderAssets>()
             .insert_resource(camera::InitialView(self.initial_view))
+            .insert_resource(self.overlays)
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.17)))
             .insert_resource(GlobalAmbientLight {
                 color: Color::WHITE,
@@ -39,6 +44,7 @@ impl Plugin for OcclusionViewPlugin {
                     tooth_render::hide_extracted,
                     camera::camera_presets,
                     camera::orbit_camera.run_if(crate::ui::pointer_free),
+                    overlays::draw_overlays,
                 )
                     .chain(),
             );

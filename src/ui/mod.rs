@@ -10,6 +10,8 @@
 //!   response), the contacts of the last step, IPR totals, and the surface gap of every adjacent pair
 //!   as a plot with the 1 mm line (measured a few times a second, only while the panel shows it).
 //!
+//! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step.
+//!
 //! Camera input is ignored while the pointer is over the panel (see [`pointer_free`]).
 
 use bevy::prelude::*;
@@ -103,6 +105,7 @@ fn panel(
     case: Option<Res<ActiveCase>>,
     teeth: Query<&Tooth>,
     mut load: MessageWriter<LoadCase>,
+    mut overlays: ResMut<crate::occlusion_view::Overlays>,
 ) -> Result {
     let dt = real.delta_secs();
     if dt > 0.0 {
@@ -209,6 +212,27 @@ fn panel(
                 if let Some(name) = &current {
                     load.write(LoadCase(name.clone()));
                 }
+            }
+
+            ui.separator();
+            ui.heading("Overlays");
+            ui.horizontal(|ui| {
+                let mut level = overlays.sphere_level;
+                egui::ComboBox::from_label("sphere level")
+                    .selected_text(level.map_or("off".to_owned(), |l| l.to_string()))
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut level, None, "off");
+                        for l in 0..trees.depth {
+                            ui.selectable_value(&mut level, Some(l), l.to_string());
+                        }
+                    });
+                if level != overlays.sphere_level {
+                    overlays.sphere_level = level;
+                }
+            });
+            let mut show_contacts = overlays.contacts;
+            if ui.checkbox(&mut show_contacts, "contacts").changed() {
+                overlays.contacts = show_contacts;
             }
 
             ui.separator();
