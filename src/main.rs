@@ -50,8 +50,9 @@ enum Command {
         /// Sphere-tree builder (depth 4, branching 8; medial from the user's tree cache).
         #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
         tree: TreeMethod,
-        /// Overlays: `spheres:LEVEL` (a sphere-tree level, 0 = root) or `contacts` (overlapping
-        /// leaf spheres and contact points of the step); repeat for several.
+        /// Overlays: `spheres:LEVEL` (a sphere-tree level, 0 = root), `contacts` (overlapping leaf
+        /// spheres and contact points of the step) or `occlusion-map` (surfaces coloured by their
+        /// distance to the opposing arch); repeat for several.
         #[cfg(feature = "viewer")]
         #[arg(long)]
         overlay: Vec<orthosim::occlusion_view::Overlay>,

@@ -3,6 +3,7 @@
 //! It only adds viewing: the simulation plugins run the same with or without it.
 
 mod camera;
+pub mod contact_map;
 pub mod overlays;
 pub mod screenshot;
 mod tooth_render;
@@ -30,6 +31,7 @@ impl Plugin for OcclusionViewPlugin {
         app.init_resource::<tooth_render::ToothRenderAssets>()
             .insert_resource(camera::InitialView(self.initial_view))
             .insert_resource(self.overlays)
+            .init_resource::<contact_map::MapState>()
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.17)))
             .insert_resource(GlobalAmbientLight {
                 color: Color::WHITE,
@@ -45,6 +47,7 @@ impl Plugin for OcclusionViewPlugin {
                     camera::camera_presets,
                     camera::orbit_camera.run_if(crate::ui::pointer_free),
                     overlays::draw_overlays,
+                    contact_map::update_contact_map,
                 )
                     .chain(),
             );

@@ -19,15 +19,19 @@ pub struct Overlays {
     pub sphere_level: Option<u32>,
     /// Contact points and overlapping leaf spheres of the current step.
     pub contacts: bool,
+    /// Tooth surfaces coloured by their distance to the opposing arch.
+    pub occlusion_map: bool,
 }
 
-/// One overlay named on the command line: `spheres:LEVEL` or `contacts`.
+/// One overlay named on the command line: `spheres:LEVEL`, `contacts` or `occlusion-map`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Overlay {
     /// A sphere-tree level.
     Spheres(u32),
     /// The contacts.
     Contacts,
+    /// The occlusal contact map.
+    OcclusionMap,
 }
 
 impl FromStr for Overlay {
@@ -35,10 +39,11 @@ impl FromStr for Overlay {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "contacts" => Ok(Overlay::Contacts),
+            "occlusion-map" => Ok(Overlay::OcclusionMap),
             _ => match s.strip_prefix("spheres:").map(str::parse::<u32>) {
                 Some(Ok(level)) if level <= 6 => Ok(Overlay::Spheres(level)),
                 _ => Err(format!(
-                    "unknown overlay '{s}': use spheres:LEVEL (0–6) or contacts"
+                    "unknown overlay '{s}': use spheres:LEVEL (0–6), contacts or occlusion-map"
                 )),
             },
         }
@@ -51,6 +56,7 @@ impl Overlays {
         match o {
             Overlay::Spheres(l) => self.sphere_level = Some(l),
             Overlay::Contacts => self.contacts = true,
+            Overlay::OcclusionMap => self.occlusion_map = true,
         }
         self
     }
@@ -120,6 +126,10 @@ mod tests {
     #[test]
     fn overlay_names_parse() {
         assert_eq!("contacts".parse::<Overlay>(), Ok(Overlay::Contacts));
+        assert_eq!(
+            "occlusion-map".parse::<Overlay>(),
+            Ok(Overlay::OcclusionMap)
+        );
         assert_eq!("spheres:3".parse::<Overlay>(), Ok(Overlay::Spheres(3)));
         assert!("spheres:x".parse::<Overlay>().is_err());
         assert!("map".parse::<Overlay>().unwrap_err().contains("map"));

@@ -17,8 +17,23 @@ pub(super) struct ToothRenderAssets {
     materials: HashMap<Arch, Handle<StandardMaterial>>,
 }
 
+impl ToothRenderAssets {
+    /// The shared mesh of a shape and the material of an arch, once made.
+    pub(super) fn handles(
+        &self,
+        shape: &ToothShape,
+        arch: Arch,
+    ) -> (Option<Handle<Mesh>>, Option<Handle<StandardMaterial>>) {
+        let key = std::sync::Arc::as_ptr(&shape.0) as usize;
+        (
+            self.meshes.get(&key).cloned(),
+            self.materials.get(&arch).cloned(),
+        )
+    }
+}
+
 /// A Bevy mesh with smooth normals from a tooth's triangle mesh.
-fn render_mesh(shape: &ToothShape) -> Mesh {
+pub(super) fn render_mesh(shape: &ToothShape) -> Mesh {
     let m = &shape.mesh;
     let positions: Vec<[f32; 3]> = m.vertices.iter().map(|v| v.to_array()).collect();
     let normals: Vec<[f32; 3]> = m.vertex_normals().iter().map(|n| n.to_array()).collect();

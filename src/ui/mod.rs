@@ -10,7 +10,8 @@
 //!   response), the contacts of the last step, IPR totals, and the surface gap of every adjacent pair
 //!   as a plot with the 1 mm line (measured a few times a second, only while the panel shows it).
 //!
-//! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step.
+//! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step, the occlusal
+//!   contact map.
 //!
 //! Camera input is ignored while the pointer is over the panel (see [`pointer_free`]).
 
@@ -230,10 +231,19 @@ fn panel(
                     overlays.sphere_level = level;
                 }
             });
-            let mut show_contacts = overlays.contacts;
-            if ui.checkbox(&mut show_contacts, "contacts").changed() {
-                overlays.contacts = show_contacts;
-            }
+            ui.horizontal(|ui| {
+                let mut show_contacts = overlays.contacts;
+                if ui.checkbox(&mut show_contacts, "contacts").changed() {
+                    overlays.contacts = show_contacts;
+                }
+                let mut map = overlays.occlusion_map;
+                if ui
+                    .checkbox(&mut map, "occlusion map (red 0 → blue 0.5 mm)")
+                    .changed()
+                {
+                    overlays.occlusion_map = map;
+                }
+            });
 
             ui.separator();
             ui.heading("Readouts");
