@@ -4,33 +4,28 @@
 
 use std::process::Command;
 
-#[test]
-fn screenshot_renders_the_teeth_in_a_real_window() {
-    let have_xvfb = Command::new("xvfb-run")
+fn have_xvfb() -> bool {
+    let ok = Command::new("xvfb-run")
         .arg("--help")
         .output()
         .is_ok_and(|o| o.status.success() || !o.stdout.is_empty() || !o.stderr.is_empty());
-    if !have_xvfb {
+    if !ok {
         eprintln!("skipped: xvfb-run is not installed (Debian packages xvfb, mesa-vulkan-drivers)");
-        return;
     }
-    let out = std::env::temp_dir().join(format!("orthosim-shot-{}.png", std::process::id()));
+    ok
+}
+
+/// Runs `orthosim screenshot` under Xvfb with `args` and returns the pixels (width, height,
+/// channels, bytes).
+fn shoot(name: &str, args: &[&str]) -> (u32, u32, usize, Vec<u8>) {
+    let out = std::env::temp_dir().join(format!("orthosim-{name}-{}.png", std::process::id()));
     let _ = std::fs::remove_file(&out);
     let run = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x800x24"])
         .arg(env!("CARGO_BIN_EXE_orthosim"))
-        .args([
-            "screenshot",
-            "--case",
-            "case1",
-            "--view",
-            "frontal",
-            "--tree",
-            "octree",
-            "--frames",
-            "20",
-            "--out",
-        ])
+        .arg("screenshot")
+        .args(args)
+        .args(["--tree", "octree", "--frames", "20", "--out"])
         .arg(&out)
         .output()
         .expect("xvfb-run starts");
@@ -43,9 +38,19 @@ fn screenshot_renders_the_teeth_in_a_real_window() {
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!((info.width, info.height), (1280, 720), "the window's size");
-    let channels = info.color_type.samples();
-    let pixels: Vec<&[u8]> = buf[..info.buffer_size()].chunks(channels).collect();
+    buf.truncate(info.buffer_size());
+    let _ = std::fs::remove_file(&out);
+    (info.width, info.height, info.color_type.samples(), buf)
+}
+
+#[test]
+fn screenshot_renders_the_teeth_in_a_real_window() {
+    if !have_xvfb() {
+        return;
+    }
+    let (w, h, channels, buf) = shoot("plain", &["--case", "case1", "--view", "frontal"]);
+    assert_eq!((w, h), (1280, 720), "the window's size");
+    let pixels: Vec<&[u8]> = buf.chunks(channels).collect();
     let distinct: std::collections::HashSet<&[u8]> = pixels.iter().copied().collect();
     assert!(distinct.len() > 200, "{} colours: blank?", distinct.len());
     // Teeth are light on a dark background: a good share of bright pixels.
@@ -55,5 +60,32 @@ fn screenshot_renders_the_teeth_in_a_real_window() {
         .count();
     let share = bright as f64 / pixels.len() as f64;
     assert!(share > 0.03 && share < 0.8, "bright share {share}");
-    let _ = std::fs::remove_file(&out);
+}
+
+#[test]
+fn the_occlusion_map_colours_the_teeth() {
+    if !have_xvfb() {
+        return;
+    }
+    let (_, _, channels, buf) = shoot(
+        "map",
+        &[
+            "--case",
+            "normal",
+            "--overlay",
+            "occlusion-map",
+            "--overlay",
+            "contacts",
+            "--overlay",
+            "spheres:1",
+        ],
+    );
+    let pixels: Vec<&[u8]> = buf.chunks(channels).collect();
+    // Most of each surface is far from the other arch: blue dominates where the teeth are.
+    let blue = pixels
+        .iter()
+        .filter(|p| p[2] > 150 && p[2] as i32 > p[0] as i32 + 30)
+        .count();
+    let share = blue as f64 / pixels.len() as f64;
+    assert!(share > 0.03, "blue share {share}");
 }
