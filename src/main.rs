@@ -56,6 +56,9 @@ enum Command {
         #[cfg(feature = "viewer")]
         #[arg(long)]
         overlay: Vec<orthosim::occlusion_view::Overlay>,
+        /// Hide an arch (`upper` or `lower`), e.g. to see the other one's occlusal surface.
+        #[arg(long, value_parser = ["upper", "lower"])]
+        hide: Vec<String>,
         /// The PNG file to write.
         #[arg(long)]
         out: std::path::PathBuf,
@@ -248,8 +251,9 @@ fn main() -> ExitCode {
             frames,
             tree,
             overlay,
+            hide,
             out,
-        } => screenshot(&case, view, frames, tree, &overlay, &out),
+        } => screenshot(&case, view, frames, tree, &overlay, &hide, &out),
         #[cfg(not(feature = "viewer"))]
         Command::Screenshot { .. } => view("none"),
         Command::Cases => {
@@ -692,12 +696,14 @@ fn window_app(case: &str, title: String, tree: TreeMethod) -> bevy::prelude::App
 }
 
 #[cfg(feature = "viewer")]
+#[allow(clippy::too_many_arguments)]
 fn screenshot(
     case: &str,
     camera: orthosim::occlusion_view::CameraPreset,
     frames: u32,
     tree: TreeMethod,
     overlays: &[orthosim::occlusion_view::Overlay],
+    hide: &[String],
     out: &std::path::Path,
 ) -> Result<()> {
     use orthosim::occlusion_view::{OcclusionViewPlugin, ScreenshotOutcome, ScreenshotPlugin};
@@ -709,10 +715,14 @@ fn screenshot(
     let mut app = window_app(case, format!("orthosim: {case}"), tree);
     app.add_plugins(OcclusionViewPlugin {
         initial_view: camera,
-        overlays: overlays.iter().fold(
-            Default::default(),
-            |o: orthosim::occlusion_view::Overlays, x| o.with(*x),
-        ),
+        overlays: orthosim::occlusion_view::Overlays {
+            hide_upper: hide.iter().any(|h| h == "upper"),
+            hide_lower: hide.iter().any(|h| h == "lower"),
+            ..overlays.iter().fold(
+                Default::default(),
+                |o: orthosim::occlusion_view::Overlays, x| o.with(*x),
+            )
+        },
     })
     .add_plugins(ScreenshotPlugin {
         path: out.to_owned(),

@@ -44,6 +44,7 @@ impl Plugin for OcclusionViewPlugin {
                 (
                     tooth_render::attach_tooth_meshes,
                     tooth_render::hide_extracted,
+                    overlays::arch_visibility,
                     camera::camera_presets,
                     camera::orbit_camera.run_if(crate::ui::pointer_free),
                     overlays::draw_overlays,

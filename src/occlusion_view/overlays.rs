@@ -12,9 +12,13 @@ use crate::{
     teeth::{Extracted, Tooth},
 };
 
-/// Which overlays are shown.
+/// Which overlays are shown, and which arches.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Overlays {
+    /// Hide the upper arch.
+    pub hide_upper: bool,
+    /// Hide the lower arch.
+    pub hide_lower: bool,
     /// Sphere-tree level to draw (0 = root), if any.
     pub sphere_level: Option<u32>,
     /// Contact points and overlapping leaf spheres of the current step.
@@ -62,6 +66,32 @@ impl Overlays {
     }
 }
 
+/// Shows or hides each arch (extracted teeth stay hidden).
+pub(super) fn arch_visibility(
+    overlays: Res<Overlays>,
+    mut teeth: Query<(&Tooth, &mut Visibility, Has<Extracted>)>,
+    added: Query<(), Added<Tooth>>,
+) {
+    if !overlays.is_changed() && added.is_empty() {
+        return;
+    }
+    for (tooth, mut v, extracted) in &mut teeth {
+        let hidden = extracted
+            || match tooth.id.arch() {
+                crate::teeth::Arch::Upper => overlays.hide_upper,
+                crate::teeth::Arch::Lower => overlays.hide_lower,
+            };
+        let want = if hidden {
+            Visibility::Hidden
+        } else {
+            Visibility::Inherited
+        };
+        if *v != want {
+            *v = want;
+        }
+    }
+}
+
 const SPHERE_COLOUR: Color = Color::srgba(0.35, 0.65, 1.0, 0.55);
 const LEAF_CONTACT_COLOUR: Color = Color::srgb(1.0, 0.55, 0.1);
 const POINT_COLOUR: Color = Color::srgb(1.0, 0.1, 0.1);
@@ -70,7 +100,7 @@ const POINT_COLOUR: Color = Color::srgb(1.0, 0.1, 0.1);
 type TreeQuery<'w, 's> = Query<
     'w,
     's,
-    (&'static Transform, &'static ToothSphereTree),
+    (Entity, &'static Transform, &'static ToothSphereTree),
     (With<Tooth>, Without<Extracted>),
 >;
 
@@ -78,12 +108,13 @@ pub(super) fn draw_overlays(
     overlays: Res<Overlays>,
     mut gizmos: Gizmos,
     teeth: TreeQuery,
+    visible: Query<&Visibility>,
     colliders: Query<(&Transform, &ToothCollider)>,
     contacts: Res<Contacts>,
 ) {
     if let Some(level) = overlays.sphere_level {
-        for (tf, tree) in &teeth {
-            if level >= tree.levels {
+        for (e, tf, tree) in &teeth {
+            if level >= tree.levels || visible.get(e).is_ok_and(|v| *v == Visibility::Hidden) {
                 continue;
             }
             for s in tree.level(level) {

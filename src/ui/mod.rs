@@ -10,6 +10,7 @@
 //!   response), the contacts of the last step, IPR totals, and the surface gap of every adjacent pair
 //!   as a plot with the 1 mm line (measured a few times a second, only while the panel shows it).
 //!
+//! - **View**: show or hide each arch.
 //! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step, the occlusal
 //!   contact map.
 //!
@@ -216,7 +217,17 @@ fn panel(
             }
 
             ui.separator();
-            ui.heading("Overlays");
+            ui.heading("View");
+            ui.horizontal(|ui| {
+                let mut upper = !overlays.hide_upper;
+                if ui.checkbox(&mut upper, "upper arch").changed() {
+                    overlays.hide_upper = !upper;
+                }
+                let mut lower = !overlays.hide_lower;
+                if ui.checkbox(&mut lower, "lower arch").changed() {
+                    overlays.hide_lower = !lower;
+                }
+            });
             ui.horizontal(|ui| {
                 let mut level = overlays.sphere_level;
                 egui::ComboBox::from_label("sphere level")
