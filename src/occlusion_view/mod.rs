@@ -11,7 +11,7 @@ mod tooth_render;
 use bevy::prelude::*;
 
 pub use camera::{CameraPreset, OrbitCamera};
-pub use overlays::{Overlay, Overlays};
+pub use overlays::{Overlay, Overlays, Selection};
 pub use screenshot::{ScreenshotOutcome, ScreenshotPlugin};
 
 /// Renders the arches with lit, tooth-coloured materials and an orbit/pan/zoom camera.
@@ -32,6 +32,7 @@ impl Plugin for OcclusionViewPlugin {
             .insert_resource(camera::InitialView(self.initial_view))
             .insert_resource(self.overlays)
             .init_resource::<contact_map::MapState>()
+            .init_resource::<Selection>()
             .insert_resource(ClearColor(Color::srgb(0.13, 0.14, 0.17)))
             .insert_resource(GlobalAmbientLight {
                 color: Color::WHITE,
@@ -48,6 +49,7 @@ impl Plugin for OcclusionViewPlugin {
                     camera::camera_presets,
                     camera::orbit_camera.run_if(crate::ui::pointer_free),
                     overlays::draw_overlays,
+                    overlays::draw_selection,
                     contact_map::update_contact_map,
                 )
                     .chain(),

@@ -92,6 +92,49 @@ pub(super) fn arch_visibility(
     }
 }
 
+/// Teeth selected in the viewer (by clicking or from the FDI chart), in selection order.
+#[derive(Resource, Clone, Debug, Default, PartialEq, Eq)]
+pub struct Selection(pub Vec<Entity>);
+
+impl Selection {
+    /// Selects only `e`, or with `add` toggles it in the selection.
+    pub fn pick(&mut self, e: Entity, add: bool) {
+        if add {
+            if let Some(i) = self.0.iter().position(|x| *x == e) {
+                self.0.remove(i);
+            } else {
+                self.0.push(e);
+            }
+        } else {
+            self.0 = vec![e];
+        }
+    }
+}
+
+const SELECTION_COLOUR: Color = Color::srgb(1.0, 0.85, 0.1);
+
+/// Rings around the selected teeth's crowns.
+pub(super) fn draw_selection(
+    selection: Res<Selection>,
+    mut gizmos: Gizmos,
+    teeth: Query<(&Transform, &crate::teeth::ToothShape)>,
+) {
+    for e in &selection.0 {
+        let Ok((tf, shape)) = teeth.get(*e) else {
+            continue;
+        };
+        let centre = tf.transform_point(shape.frame.crown_centre);
+        let axis = (tf.rotation * shape.frame.long_axis).normalize_or(Vec3::Y);
+        let radius = 0.6 * shape.anatomy.mesiodistal.max(shape.anatomy.buccolingual);
+        gizmos.circle(
+            Isometry3d::new(centre, Quat::from_rotation_arc(Vec3::Z, axis)),
+            radius,
+            SELECTION_COLOUR,
+        );
+        gizmos.sphere(Isometry3d::from_translation(centre), 0.3, SELECTION_COLOUR);
+    }
+}
+
 const SPHERE_COLOUR: Color = Color::srgba(0.35, 0.65, 1.0, 0.55);
 const LEAF_CONTACT_COLOUR: Color = Color::srgb(1.0, 0.55, 0.1);
 const POINT_COLOUR: Color = Color::srgb(1.0, 0.1, 0.1);

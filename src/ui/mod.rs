@@ -10,6 +10,9 @@
 //!   response), the contacts of the last step, IPR totals, and the surface gap of every adjacent pair
 //!   as a plot with the 1 mm line (measured a few times a second, only while the panel shows it).
 //!
+//! - **Teeth and loads**: select teeth by clicking them (shift-click for a group) or from an FDI
+//!   chart, and set a force or torque on them with presets along each tooth's mesial, buccal and
+//!   occlusal axes (mesial/distal, buccal/lingual, extrusion/intrusion, tipping, rotation, torque).
 //! - **View**: show or hide each arch.
 //! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step, the occlusal
 //!   contact map.
@@ -22,11 +25,14 @@ use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use crate::{
     collision::{CollisionSettings, Contacts, Method},
+    movement::SetLoad,
     movement::{
         MovementSettings, MovementStatus, Response, SimulationState, report::pair_distances,
     },
+    occlusion_view::Selection,
     sphere_tree::{SphereTreeSettings, TreeMethod},
     teeth::{ActiveCase, Case, LoadCase, Tooth},
+    teeth::{Extracted, Load},
 };
 
 /// The panel and the simulation controls.
@@ -37,8 +43,13 @@ impl Plugin for OrthoSimUiPlugin {
         if !app.is_plugin_added::<EguiPlugin>() {
             app.add_plugins(EguiPlugin::default());
         }
+        if !app.is_plugin_added::<bevy::picking::mesh_picking::MeshPickingPlugin>() {
+            app.add_plugins(bevy::picking::mesh_picking::MeshPickingPlugin);
+        }
         app.init_resource::<PanelState>()
-            .add_systems(EguiPrimaryContextPass, panel)
+            .init_resource::<LoadEditor>()
+            .add_observer(click_tooth)
+            .add_systems(EguiPrimaryContextPass, (panel, loads_panel))
             .add_systems(Update, single_step);
     }
 }
@@ -80,6 +91,163 @@ impl Default for PanelState {
             frame: 1.0 / 60.0,
         }
     }
+}
+
+/// Selects a tooth by clicking it (shift-click adds or removes it).
+fn click_tooth(
+    click: On<Pointer<Click>>,
+    teeth: Query<(), With<Tooth>>,
+    keys: Option<Res<ButtonInput<KeyCode>>>,
+    mut selection: ResMut<Selection>,
+) {
+    if click.event.button != PointerButton::Primary || !teeth.contains(click.entity) {
+        return;
+    }
+    let add = keys.is_some_and(|k| k.pressed(KeyCode::ShiftLeft) || k.pressed(KeyCode::ShiftRight));
+    selection.pick(click.entity, add);
+}
+
+/// An axis of a tooth (0 mesial, 1 buccal, 2 occlusal) and a sign.
+type AxisSign = (usize, f32);
+
+/// The load being composed for the selection.
+#[derive(Resource)]
+struct LoadEditor {
+    force_n: f32,
+    torque_nmm: f32,
+}
+
+impl Default for LoadEditor {
+    fn default() -> Self {
+        Self {
+            force_n: 1.5,
+            torque_nmm: 15.0,
+        }
+    }
+}
+
+/// Selection (FDI chart) and loads on the selected teeth, with presets along each tooth's own
+/// mesial, buccal and occlusal axes.
+fn loads_panel(
+    mut contexts: EguiContexts,
+    mut editor: ResMut<LoadEditor>,
+    mut selection: ResMut<Selection>,
+    teeth: Query<(Entity, &Tooth, &Transform, &Load, Has<Extracted>)>,
+    mut set: MessageWriter<SetLoad>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?;
+    egui::Window::new("Teeth and loads")
+        .default_pos([ctx.viewport_rect().width() - 350.0, 10.0])
+        .default_width(330.0)
+        .show(ctx, |ui| {
+            ui.label("Click a tooth (shift-click for a group) or use the chart:");
+            let find = |n: u8| teeth.iter().find(|t| t.1.id.number() == n);
+            for row in [
+                [
+                    18u8, 17, 16, 15, 14, 13, 12, 11, 21, 22, 23, 24, 25, 26, 27, 28,
+                ],
+                [
+                    48, 47, 46, 45, 44, 43, 42, 41, 31, 32, 33, 34, 35, 36, 37, 38,
+                ],
+            ] {
+                ui.horizontal_wrapped(|ui| {
+                    ui.spacing_mut().item_spacing.x = 2.0;
+                    for n in row {
+                        let Some((e, _, _, _, extracted)) = find(n) else {
+                            ui.add_enabled(false, egui::Button::new(n.to_string()).small());
+                            continue;
+                        };
+                        let on = selection.0.contains(&e);
+                        let b = ui.add_enabled(
+                            !extracted,
+                            egui::Button::new(n.to_string()).small().selected(on),
+                        );
+                        if b.clicked() {
+                            selection.pick(e, true);
+                        }
+                    }
+                });
+            }
+            let names: Vec<String> = selection
+                .0
+                .iter()
+                .filter_map(|e| teeth.get(*e).ok().map(|t| t.1.id.to_string()))
+                .collect();
+            ui.label(format!(
+                "selected: {}",
+                if names.is_empty() {
+                    "none".to_owned()
+                } else {
+                    names.join(" ")
+                }
+            ));
+            ui.add(egui::Slider::new(&mut editor.force_n, 0.0..=5.0).text("force N"));
+            ui.add(egui::Slider::new(&mut editor.torque_nmm, 0.0..=50.0).text("torque N·mm"));
+            // (label, force axis and sign, torque axis and sign): 0 mesial, 1 buccal, 2 occlusal.
+            let presets: [(&str, Option<AxisSign>, Option<AxisSign>); 9] = [
+                ("mesial", Some((0, 1.0)), None),
+                ("distal", Some((0, -1.0)), None),
+                ("buccal", Some((1, 1.0)), None),
+                ("lingual", Some((1, -1.0)), None),
+                ("extrusion", Some((2, 1.0)), None),
+                ("intrusion", Some((2, -1.0)), None),
+                ("tip (crown mesial)", None, Some((1, 1.0))),
+                ("rotate", None, Some((2, 1.0))),
+                ("torque", None, Some((0, 1.0))),
+            ];
+            let mut chosen = None;
+            ui.horizontal_wrapped(|ui| {
+                for (label, f, t) in presets {
+                    if ui
+                        .add_enabled(!selection.0.is_empty(), egui::Button::new(label))
+                        .clicked()
+                    {
+                        chosen = Some((f, t));
+                    }
+                }
+                if ui
+                    .add_enabled(!selection.0.is_empty(), egui::Button::new("clear"))
+                    .clicked()
+                {
+                    chosen = Some((None, None));
+                }
+            });
+            if let Some((f, t)) = chosen {
+                for e in &selection.0 {
+                    let Ok((_, tooth, tf, current, _)) = teeth.get(*e) else {
+                        continue;
+                    };
+                    let axes = [
+                        tf.rotation * (Vec3::X * tooth.id.local_x_mesial_sign()),
+                        tf.rotation * Vec3::Z,
+                        tf.rotation * Vec3::Y,
+                    ];
+                    let mut load = if f.is_none() && t.is_none() {
+                        Load::default()
+                    } else {
+                        *current
+                    };
+                    if let Some((k, sign)) = f {
+                        load.force = axes[k] * sign * editor.force_n;
+                    }
+                    if let Some((k, sign)) = t {
+                        load.torque = axes[k] * sign * editor.torque_nmm;
+                    }
+                    set.write(SetLoad { tooth: *e, load });
+                }
+            }
+            for e in &selection.0 {
+                if let Ok((_, tooth, _, l, _)) = teeth.get(*e) {
+                    ui.label(format!(
+                        "{}: force {:.2} N, torque {:.1} N·mm",
+                        tooth.id,
+                        l.force.length(),
+                        l.torque.length()
+                    ));
+                }
+            }
+        });
+    Ok(())
 }
 
 /// Runs one fixed simulation step while paused.
@@ -249,7 +417,7 @@ fn panel(
                 }
                 let mut map = overlays.occlusion_map;
                 if ui
-                    .checkbox(&mut map, "occlusion map (red 0 → blue 0.5 mm)")
+                    .checkbox(&mut map, "occlusion map (red 0 to blue 0.5 mm)")
                     .changed()
                 {
                     overlays.occlusion_map = map;
