@@ -485,15 +485,7 @@ fn run_report_command(
     let progress = std::io::stderr().is_terminal();
     let bar = |what: &str, done: usize, total: usize| {
         if progress {
-            let filled = done * 30 / total.max(1);
-            eprint!(
-                "\r[{}{}] {done}/{total} {what:<32}",
-                "#".repeat(filled),
-                " ".repeat(30 - filled)
-            );
-            if done == total {
-                eprintln!();
-            }
+            progress_bar(&format!("{what:<32}"), done, total);
         }
     };
     let summary = run_report(&opts, out, &bar)?;
@@ -503,6 +495,19 @@ fn run_report_command(
         summary.cases.keys().cloned().collect::<Vec<_>>().join(", ")
     );
     Ok(())
+}
+
+/// One line of progress on stderr: `\r[####    ] done/total what`, ended when done.
+fn progress_bar(what: &str, done: usize, total: usize) {
+    let filled = (done * 30 / total.max(1)).min(30);
+    eprint!(
+        "\r[{}{}] {done}/{total} {what}",
+        "#".repeat(filled),
+        " ".repeat(30 - filled)
+    );
+    if done == total {
+        eprintln!();
+    }
 }
 
 /// Prints one pretty JSON object on stdout.
@@ -598,15 +603,7 @@ fn run_trees(
     let progress = std::io::stderr().is_terminal();
     let bar = |done: usize, total: usize| {
         if progress {
-            let filled = done * 30 / total.max(1);
-            eprint!(
-                "\rbuilding trees [{}{}] {done}/{total}",
-                "#".repeat(filled),
-                " ".repeat(30 - filled)
-            );
-            if done == total {
-                eprintln!();
-            }
+            progress_bar("building trees", done, total);
         }
     };
     let (report, trees) = trees_report(&dentition, settings, cache, &bar)?;

@@ -58,6 +58,19 @@ pub struct Posed<'a> {
     pub pose: Pose,
 }
 
+impl<'a> Posed<'a> {
+    /// The visible teeth of a dentition as placed.
+    pub fn of_dentition(d: &'a crate::teeth::Dentition) -> Vec<Self> {
+        d.visible()
+            .map(|t| Posed {
+                fdi: t.fdi,
+                geometry: &t.geometry,
+                pose: t.pose,
+            })
+            .collect()
+    }
+}
+
 /// Occlusal contact of one tooth with the opposing arch.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct OcclusalContact {
@@ -287,14 +300,7 @@ mod tests {
         // width.
         let measure = |case: &str| {
             let d = Dentition::build(Case::resolve(case).unwrap()).unwrap();
-            let teeth: Vec<Posed> = d
-                .visible()
-                .map(|t| Posed {
-                    fdi: t.fdi,
-                    geometry: &t.geometry,
-                    pose: t.pose,
-                })
-                .collect();
+            let teeth = Posed::of_dentition(&d);
             let arches = arch_positions(&teeth);
             let w = |f: Fdi| d.tooth(f).unwrap().geometry.anatomy.mesiodistal;
             bolton(w, [&arches[0], &arches[1]])

@@ -281,14 +281,7 @@ pub fn run_report(
         }
     }
     progress("writing", done, total);
-    let posed: Vec<Posed> = normal
-        .visible()
-        .map(|t| Posed {
-            fdi: t.fdi,
-            geometry: &t.geometry,
-            pose: t.pose,
-        })
-        .collect();
+    let posed = Posed::of_dentition(&normal);
     let arches = arch_positions(&posed);
     let width = |f| {
         normal

@@ -18,7 +18,7 @@
 //! interpenetrating are left out of the error (no method can undo a start pose), not out of the
 //! counts.
 
-use std::{sync::Arc, time::Instant};
+use std::time::Instant;
 
 use glam::{Quat, Vec3};
 use serde::Serialize;
@@ -30,7 +30,7 @@ use super::{
 };
 use crate::{
     geometry::{MeshRef, Pose, mesh_separation},
-    sphere_tree::{SphereTree, TreeCache, TreeSettings},
+    sphere_tree::{TreeCache, TreeSettings},
     teeth::{Dentition, Fdi},
 };
 
@@ -101,22 +101,12 @@ pub fn bench_teeth(
     settings: TreeSettings,
     cache: Option<&TreeCache>,
 ) -> Vec<BenchTooth> {
-    let visible: Vec<_> = d.visible().cloned().collect();
-    let trees: Vec<SphereTree> = crate::parallel::parallel_map(&visible, |t| {
-        match cache {
-            Some(c) => c
-                .load_or_build(&settings, &t.geometry.mesh, &t.geometry.bvh)
-                .map(|x| x.0),
-            None => settings.build(&t.geometry.mesh, &t.geometry.bvh),
-        }
-        .expect("validated settings")
-    });
-    visible
-        .iter()
-        .zip(&trees)
-        .map(|(t, tree)| BenchTooth {
+    let shapes = super::shape::collision_shapes(d, settings, cache).expect("validated settings");
+    d.visible()
+        .zip(shapes)
+        .map(|(t, (_, shape))| BenchTooth {
             fdi: t.fdi,
-            shape: CollisionShape::new(Arc::clone(&t.geometry), tree),
+            shape,
             circle: Circle::of(&t.geometry, &t.pose),
             rest: t.pose,
         })

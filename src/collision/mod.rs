@@ -18,4 +18,4 @@ pub use plugin::{
     CollisionPlugin, CollisionSettings, Contact, ContactStarted, Contacts, SimulationSystems,
     ToothCollider, ToothContact, ToothMotion,
 };
-pub use shape::{Circle, CollisionShape, CompactTree};
+pub use shape::{Circle, CollisionShape, CompactTree, collision_shapes};

@@ -7,8 +7,8 @@ use glam::{Vec2, Vec3};
 
 use crate::{
     geometry::{Pose, Sphere},
-    sphere_tree::SphereTree,
-    teeth::ToothGeometry,
+    sphere_tree::{SphereTree, TreeCache, TreeSettings, build::TreeBuildError},
+    teeth::{Dentition, Fdi, ToothGeometry},
 };
 
 /// A sphere tree without empty slots, children stored contiguously, for fast descent.
@@ -152,4 +152,37 @@ impl CollisionShape {
             max_rho,
         }
     }
+}
+
+/// Collision shapes of the visible teeth of `d`, each distinct tooth shape's tree built once (in
+/// parallel) or read from `cache`.
+pub fn collision_shapes(
+    d: &Dentition,
+    trees: TreeSettings,
+    cache: Option<&TreeCache>,
+) -> Result<Vec<(Fdi, CollisionShape)>, TreeBuildError> {
+    trees.validate()?;
+    let mut distinct: Vec<Arc<ToothGeometry>> = Vec::new();
+    for t in d.visible() {
+        if !distinct.iter().any(|g| Arc::ptr_eq(g, &t.geometry)) {
+            distinct.push(t.geometry.clone());
+        }
+    }
+    let built = crate::parallel::parallel_map(&distinct, |g| match cache {
+        Some(c) => c.load_or_build(&trees, &g.mesh, &g.bvh).map(|x| x.0),
+        None => trees.build(&g.mesh, &g.bvh),
+    });
+    let mut shapes = Vec::with_capacity(distinct.len());
+    for (g, tree) in distinct.iter().zip(built) {
+        shapes.push(CollisionShape::new(g.clone(), &tree?));
+    }
+    Ok(d.visible()
+        .map(|t| {
+            let k = distinct
+                .iter()
+                .position(|g| Arc::ptr_eq(g, &t.geometry))
+                .expect("listed above");
+            (t.fdi, shapes[k].clone())
+        })
+        .collect())
 }

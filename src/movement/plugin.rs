@@ -265,21 +265,20 @@ fn resolve(
     contacts: Res<Contacts>,
     mut motions: Query<&mut ToothMotion>,
 ) {
-    let state_ref = &mut *state;
-    if state_ref.skip {
+    if state.skip {
         return;
     }
-    let Some(sim) = state_ref.sim.as_mut() else {
+    let Some(moving) = state
+        .sim
+        .as_ref()
+        .map(|sim| sim.motions.iter().any(|m| !m.is_still()))
+    else {
         return;
     };
-    let moving = sim.motions.iter().any(|m| !m.is_still());
     let mut found = Vec::new();
     if moving {
         for c in &contacts.list {
-            let (Some(i), Some(j)) = (
-                state_ref.entities.iter().position(|x| *x == c.a),
-                state_ref.entities.iter().position(|x| *x == c.b),
-            ) else {
+            let (Some(i), Some(j)) = (state.index_of(c.a), state.index_of(c.b)) else {
                 continue;
             };
             let mut contact = PairContact {
@@ -300,7 +299,9 @@ fn resolve(
             found.push(Found { a, b, contact });
         }
     }
-    sim.resolve(found);
+    if let Some(sim) = state.sim.as_mut() {
+        sim.resolve(found);
+    }
     write_motions(&state, &mut motions);
 }
 

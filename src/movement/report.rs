@@ -6,19 +6,16 @@
 //! `max_penetration_mm` is the exact triangle-level penetration depth, the largest over every pair
 //! of teeth whose boxes overlap at the end.
 
-use std::{collections::BTreeMap, sync::Arc, time::Instant};
+use std::{collections::BTreeMap, time::Instant};
 
 use serde::Serialize;
 
-use super::{
-    settings::{MovementSettings, Response},
-    sim::Simulation,
-};
+use super::{settings::MovementSettings, sim::Simulation};
 use crate::{
-    collision::{CollisionShape, Method},
+    collision::{Method, shape::collision_shapes},
     geometry::mesh_separation,
-    sphere_tree::{TreeCache, TreeSettings, build::TreeBuildError},
-    teeth::{Arch, Case, Dentition, Fdi, ToothGeometry},
+    sphere_tree::{TreeCache, TreeSettings},
+    teeth::{Arch, Case, Dentition, Fdi},
 };
 
 /// Crown-centre travel above which a tooth counts as moved (mm).
@@ -143,39 +140,6 @@ pub fn max_penetration(sim: &Simulation) -> f32 {
     worst
 }
 
-/// Collision shapes of the visible teeth of `d`, each distinct tooth shape's tree built once (in
-/// parallel) or read from `cache`.
-pub fn collision_shapes(
-    d: &Dentition,
-    trees: TreeSettings,
-    cache: Option<&TreeCache>,
-) -> Result<Vec<(Fdi, CollisionShape)>, TreeBuildError> {
-    trees.validate()?;
-    let mut distinct: Vec<Arc<ToothGeometry>> = Vec::new();
-    for t in d.visible() {
-        if !distinct.iter().any(|g| Arc::ptr_eq(g, &t.geometry)) {
-            distinct.push(t.geometry.clone());
-        }
-    }
-    let built = crate::parallel::parallel_map(&distinct, |g| match cache {
-        Some(c) => c.load_or_build(&trees, &g.mesh, &g.bvh).map(|x| x.0),
-        None => trees.build(&g.mesh, &g.bvh),
-    });
-    let mut shapes = Vec::with_capacity(distinct.len());
-    for (g, tree) in distinct.iter().zip(built) {
-        shapes.push(CollisionShape::new(g.clone(), &tree?));
-    }
-    Ok(d.visible()
-        .map(|t| {
-            let k = distinct
-                .iter()
-                .position(|g| Arc::ptr_eq(g, &t.geometry))
-                .expect("listed above");
-            (t.fdi, shapes[k].clone())
-        })
-        .collect())
-}
-
 /// A finished run: the report and the simulation in its final state.
 pub struct CaseRun {
     /// The measures.
@@ -219,12 +183,7 @@ pub fn run_case(
     let report = SimulationReport {
         case: name,
         algorithm: method.name().to_owned(),
-        response: match settings.response {
-            Response::Block => "block",
-            Response::Impulse => "impulse",
-            Response::Ipr => "ipr",
-        }
-        .to_owned(),
+        response: settings.response.name().to_owned(),
         steps: sim.steps,
         at_rest,
         moved: sim

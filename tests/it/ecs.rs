@@ -9,7 +9,7 @@ use orthosim::{
 };
 
 /// A headless app with the simulation plugins and a manual clock.
-fn create_app() -> App {
+pub(crate) fn create_app() -> App {
     app_with(OrthoSimPlugins.build())
 }
 

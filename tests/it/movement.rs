@@ -7,12 +7,14 @@
 
 use std::{sync::OnceLock, time::Duration};
 
-use bevy::{prelude::*, time::TimeUpdateStrategy};
+use crate::ecs::create_app;
+
+use bevy::prelude::*;
 use orthosim::{
-    collision::Method,
+    collision::{Method, collision_shapes},
     movement::{
         MovementSettings, MovementStatus, Response, Simulation, SimulationState,
-        report::{CaseRun, collision_shapes, max_penetration, run_case},
+        report::{CaseRun, max_penetration, run_case},
     },
     prelude::*,
     sphere_tree::{TreeCache, TreeMethod, TreeSettings},
@@ -298,18 +300,6 @@ fn ipr_records_the_overlap_within_its_limit() {
     }
     assert!(r.report.max_penetration_mm <= limit + 0.07);
     assert!(r.report.at_rest);
-}
-
-/// A headless app with the simulation plugins and a manual clock.
-fn create_app() -> App {
-    let mut app = App::new();
-    app.add_plugins((MinimalPlugins, TransformPlugin, OrthoSimPlugins))
-        .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-            16,
-        )));
-    app.finish();
-    app.cleanup();
-    app
 }
 
 #[test]
