@@ -15,7 +15,8 @@ pub mod sim;
 
 pub use model::ToothConstraint;
 pub use plugin::{
-    MovementPlugin, MovementStatus, SetGroupLoad, SetLoad, SimulationState, ToothImpact,
+    MovementPlugin, MovementStatus, SetExtracted, SetGroupLoad, SetLoad, SetWire, SimulationState,
+    ToothImpact,
 };
 pub use report::{PairDistance, SimulationReport, run_case};
 pub use settings::{MovementSettings, Response};

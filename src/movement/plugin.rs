@@ -22,7 +22,7 @@ use crate::{
         CollisionSettings, Contacts, PairContact, SimulationSystems, ToothCollider, ToothMotion,
         motion::Motion,
     },
-    teeth::{ActiveCase, Dentition, Extracted, Load, Tooth},
+    teeth::{ActiveCase, Dentition, Extracted, Load, Tooth, Wire, WireModel},
 };
 
 /// The running simulation of the active case.
@@ -37,6 +37,8 @@ pub struct SimulationState {
     /// This step is skipped (some tooth does not carry its `ToothMotion` yet, so the collision
     /// stage could not see the motions).
     skip: bool,
+    /// The last edit of the teeth that was refused, and why (for the panel).
+    pub notice: Option<String>,
 }
 
 impl SimulationState {
@@ -81,6 +83,26 @@ pub struct SetGroupLoad {
     pub load: Load,
 }
 
+/// Set a tooth's archwire model from code.
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SetWire {
+    /// The tooth.
+    pub tooth: Entity,
+    /// Its wire model from now on.
+    pub wire: WireModel,
+}
+
+/// Extract a tooth (`extracted: true`) or restore it, while the case runs (see
+/// [`Simulation::with_extraction`]). A refused restore is reported in
+/// [`SimulationState::notice`].
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SetExtracted {
+    /// The tooth.
+    pub tooth: Entity,
+    /// Extract (true) or restore (false).
+    pub extracted: bool,
+}
+
 /// An impact of the `impulse` response.
 #[derive(Message, Clone, Debug, PartialEq, Deref)]
 pub struct ToothImpact(pub Impact);
@@ -107,12 +129,16 @@ impl Plugin for MovementPlugin {
             .init_resource::<CollisionClock>()
             .add_message::<SetLoad>()
             .add_message::<SetGroupLoad>()
+            .add_message::<SetWire>()
+            .add_message::<SetExtracted>()
             .add_message::<ToothImpact>()
             .add_systems(
                 self.schedule,
                 (
                     start_simulation.before(SimulationSystems::Loads),
-                    apply_loads.in_set(SimulationSystems::Loads),
+                    (edit_teeth, apply_loads)
+                        .chain()
+                        .in_set(SimulationSystems::Loads),
                     propose.in_set(SimulationSystems::Motion),
                     start_clock
                         .after(SimulationSystems::Motion)
@@ -189,6 +215,74 @@ fn start_simulation(
             state.entities = entities;
         }
         Err(e) => error!("cannot simulate case '{}': {e}", case.case.case.name),
+    }
+}
+
+/// Wire models, extractions and restorations asked for by [`SetWire`] and [`SetExtracted`].
+fn edit_teeth(
+    mut commands: Commands,
+    mut state: ResMut<SimulationState>,
+    case: Option<Res<ActiveCase>>,
+    mut wires: MessageReader<SetWire>,
+    mut extractions: MessageReader<SetExtracted>,
+    teeth: Query<(Entity, &Tooth, Option<&ToothCollider>, Has<Extracted>)>,
+) {
+    let state = &mut *state;
+    let (Some(sim), Some(case)) = (state.sim.as_mut(), case) else {
+        wires.clear();
+        extractions.clear();
+        return;
+    };
+    for m in wires.read() {
+        if let Some(i) = state.entities.iter().position(|e| *e == m.tooth) {
+            sim.set_wire(i, m.wire);
+        }
+        if teeth.contains(m.tooth) {
+            commands.entity(m.tooth).try_insert(Wire(m.wire));
+        }
+    }
+    let mut extracted: std::collections::HashMap<Entity, bool> =
+        teeth.iter().map(|(e, _, _, x)| (e, x)).collect();
+    for m in extractions.read() {
+        let Ok((_, tooth, collider, _)) = teeth.get(m.tooth) else {
+            continue;
+        };
+        if extracted.get(&m.tooth) == Some(&m.extracted) {
+            continue;
+        }
+        let shape = collider.map(|c| c.shape.clone());
+        let next = match sim.with_extraction(&case.0, tooth.id, m.extracted, shape) {
+            Ok(next) => next,
+            Err(e) => {
+                warn!("{e}");
+                state.notice = Some(e);
+                continue;
+            }
+        };
+        *sim = next;
+        state.notice = None;
+        extracted.insert(m.tooth, m.extracted);
+        if m.extracted {
+            commands.entity(m.tooth).try_insert(Extracted);
+        } else {
+            commands.entity(m.tooth).try_remove::<Extracted>();
+        }
+        state.entities = sim
+            .teeth
+            .iter()
+            .filter_map(|t| {
+                teeth
+                    .iter()
+                    .find(|(_, tooth, _, _)| tooth.id == t.fdi)
+                    .map(|(e, ..)| e)
+            })
+            .collect();
+        for (e, t) in state.entities.iter().zip(&sim.teeth) {
+            commands.entity(*e).try_insert((
+                ToothMotion(Motion::still(t.pose)),
+                Transform::from_translation(t.pose.translation).with_rotation(t.pose.rotation),
+            ));
+        }
     }
 }
 

@@ -349,6 +349,112 @@ impl Simulation {
         self.teeth[i].load = load;
     }
 
+    /// Replaces a tooth's archwire model.
+    pub fn set_wire(&mut self, i: usize, wire: WireModel) {
+        self.teeth[i].wire = wire;
+    }
+
+    /// The same simulation with tooth `fdi` extracted (`extract`) or restored, for extracting and
+    /// restoring teeth while a case runs. `d` is the case the simulation was made from; `shape` is
+    /// the restored tooth's collision shape (unused when extracting).
+    ///
+    /// The other teeth keep their current poses, loads, wire models and displacements, and the step
+    /// count, IPR record and impact totals carry over; forces passed between neighbours start
+    /// afresh (the neighbours changed). A restored tooth comes back at its place in the case with
+    /// its case load; it is refused, with the reason, when a tooth has moved into that place (the
+    /// meshes would overlap) or when it is not a tooth of the case.
+    pub fn with_extraction(
+        &self,
+        d: &Dentition,
+        fdi: Fdi,
+        extract: bool,
+        shape: Option<CollisionShape>,
+    ) -> Result<Self, String> {
+        let Some(placed) = d.tooth(fdi) else {
+            return Err(format!("tooth {fdi} is not in the case"));
+        };
+        let present = self.index_of(fdi).is_some();
+        if extract && !present {
+            return Err(format!("tooth {fdi} is already extracted"));
+        }
+        if !extract && present {
+            return Err(format!("tooth {fdi} is already in place"));
+        }
+        let mut shapes: Vec<(Fdi, CollisionShape)> = self
+            .teeth
+            .iter()
+            .filter(|t| t.fdi != fdi)
+            .map(|t| (t.fdi, t.shape.clone()))
+            .collect();
+        if !extract {
+            let shape = shape.ok_or_else(|| format!("tooth {fdi} has no collision shape yet"))?;
+            let radius = shape
+                .tree
+                .spheres
+                .first()
+                .map_or(f32::INFINITY, |s| s.radius);
+            let centre = shape
+                .tree
+                .spheres
+                .first()
+                .map_or(Vec3::ZERO, |s| placed.pose.transform_point(s.centre));
+            for t in &self.teeth {
+                let Some(root) = t.shape.tree.spheres.first() else {
+                    continue;
+                };
+                let far =
+                    t.pose.transform_point(root.centre).distance(centre) > radius + root.radius;
+                if far {
+                    continue;
+                }
+                let sep = mesh_separation(
+                    shape.geometry.mesh_ref(),
+                    &placed.pose,
+                    t.shape.geometry.mesh_ref(),
+                    &t.pose,
+                );
+                if sep.overlapping() {
+                    return Err(format!(
+                        "cannot restore tooth {fdi}: tooth {} has moved into its place \
+                         (overlap {:.2} mm)",
+                        t.fdi, sep.penetration
+                    ));
+                }
+            }
+            shapes.push((fdi, shape));
+        }
+        let mut edited = d.clone();
+        for t in &mut edited.teeth {
+            if t.fdi == fdi {
+                t.extracted = extract;
+            } else if let Some(i) = self.index_of(t.fdi) {
+                t.extracted = false;
+                t.pose = self.teeth[i].pose;
+            } else {
+                t.extracted = true;
+            }
+        }
+        let mut next = Self::new(&edited, shapes, self.method, self.settings)?;
+        for t in &mut next.teeth {
+            if let Some(i) = self.index_of(t.fdi) {
+                let old = &self.teeth[i];
+                t.initial = old.initial;
+                t.load = old.load;
+                t.wire = old.wire;
+            } else {
+                t.initial = placed.pose;
+            }
+        }
+        for (g, old) in next.groups.iter_mut().zip(&self.groups) {
+            g.load = old.load;
+        }
+        next.steps = self.steps;
+        next.ipr = self.ipr.clone();
+        next.total_impacts = self.total_impacts;
+        next.total_energy_lost_uj = self.total_energy_lost_uj;
+        Ok(next)
+    }
+
     /// Forces received from blocked neighbours, acting in the coming step.
     pub fn passed_forces(&self) -> &[Vec3] {
         &self.next_passed

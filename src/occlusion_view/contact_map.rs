@@ -2,10 +2,11 @@
 //! surface coloured by its distance to the opposing arch, red at contact (or overlap) through
 //! yellow and green to blue at [`MAP_RANGE_MM`] and beyond.
 //!
-//! Only done while shown: each tooth then gets its own coloured copy of its mesh (teeth otherwise
-//! share one mesh per shape), and a tooth's colours are measured again only when it or one of its
-//! antagonists moved (at most [`REFRESH_S`] apart). Distances are exact (closest point on the
-//! antagonist's triangles, inside test for overlap) at the mesh vertices.
+//! Only done while shown: each tooth then gets its own coloured copy of its crown mesh (teeth
+//! otherwise share one mesh per shape; roots keep their own look), and a tooth's colours are
+//! measured again only when it or one of its antagonists moved (at most [`REFRESH_S`] apart).
+//! Distances are exact (closest point on the antagonist's triangles, inside test for overlap) at
+//! the crown's mesh vertices.
 
 use std::collections::HashMap;
 
@@ -132,12 +133,13 @@ pub(super) fn update_contact_map(
         if !stale {
             continue;
         }
-        let colours: Vec<[f32; 4]> = shape
-            .mesh
-            .vertices
+        let Some(crown) = assets.crown_vertices(shape) else {
+            continue;
+        };
+        let colours: Vec<[f32; 4]> = crown
             .iter()
-            .map(|&v| {
-                let p = tf.transform_point(v);
+            .map(|&i| {
+                let p = tf.transform_point(shape.mesh.vertices[i as usize]);
                 let mut best = f32::INFINITY;
                 for o in &antagonists {
                     let local = o.3.compute_affine().inverse().transform_point3(p);
@@ -174,7 +176,8 @@ pub(super) fn update_contact_map(
             None => false,
         };
         if !updated {
-            let mesh = super::tooth_render::render_mesh(&shape)
+            let mesh = super::tooth_render::render_parts(&shape)
+                .0
                 .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, colours);
             let handle = meshes.add(mesh);
             commands.entity(e).insert((

@@ -11,7 +11,7 @@ mod tooth_render;
 use bevy::prelude::*;
 
 pub use camera::{CameraPreset, OrbitCamera};
-pub use overlays::{Overlay, Overlays, Selection};
+pub use overlays::{Overlay, Overlays, Roots, Selection};
 pub use screenshot::{ScreenshotOutcome, ScreenshotPlugin};
 
 /// Renders the arches with lit, tooth-coloured materials and an orbit/pan/zoom camera.
@@ -45,10 +45,12 @@ impl Plugin for OcclusionViewPlugin {
                 (
                     tooth_render::attach_tooth_meshes,
                     tooth_render::hide_extracted,
+                    tooth_render::root_style,
                     overlays::arch_visibility,
                     camera::camera_presets,
                     camera::orbit_camera.run_if(crate::ui::pointer_free),
                     overlays::draw_overlays,
+                    overlays::draw_circles,
                     overlays::draw_selection,
                     contact_map::update_contact_map,
                 )

@@ -7,7 +7,8 @@ use std::str::FromStr;
 use bevy::prelude::*;
 
 use crate::{
-    collision::{Contacts, ToothCollider},
+    collision::{CollisionSettings, Contacts, Method, ToothCollider},
+    geometry::Pose,
     sphere_tree::ToothSphereTree,
     teeth::{Extracted, Tooth},
 };
@@ -25,9 +26,52 @@ pub struct Overlays {
     pub contacts: bool,
     /// Tooth surfaces coloured by their distance to the opposing arch.
     pub occlusion_map: bool,
+    /// Bounding circles in the x–z plane, drawn while the `circles` method is active (pairs whose
+    /// circles meet in red).
+    pub circles: bool,
+    /// How roots are drawn.
+    pub roots: Roots,
 }
 
-/// One overlay named on the command line: `spheres:LEVEL`, `contacts` or `occlusion-map`.
+/// How roots are drawn: translucent by default, so that the crowns stay clear and roots show
+/// through each other.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Roots {
+    /// Opaque, like the crowns.
+    Solid,
+    /// Semi-transparent.
+    #[default]
+    Translucent,
+    /// Not drawn.
+    Hidden,
+}
+
+impl Roots {
+    /// All styles, for lists.
+    pub const ALL: [Roots; 3] = [Roots::Translucent, Roots::Solid, Roots::Hidden];
+
+    /// The style's name on the command line and in the panel.
+    pub fn name(self) -> &'static str {
+        match self {
+            Roots::Solid => "solid",
+            Roots::Translucent => "translucent",
+            Roots::Hidden => "hidden",
+        }
+    }
+}
+
+impl FromStr for Roots {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Roots::ALL
+            .into_iter()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| format!("unknown root style '{s}': use solid, translucent or hidden"))
+    }
+}
+
+/// One overlay named on the command line: `spheres:LEVEL`, `contacts`, `occlusion-map` or
+/// `circles`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Overlay {
     /// A sphere-tree level.
@@ -36,6 +80,8 @@ pub enum Overlay {
     Contacts,
     /// The occlusal contact map.
     OcclusionMap,
+    /// Bounding circles (while the `circles` method is active).
+    Circles,
 }
 
 impl FromStr for Overlay {
@@ -44,10 +90,11 @@ impl FromStr for Overlay {
         match s {
             "contacts" => Ok(Overlay::Contacts),
             "occlusion-map" => Ok(Overlay::OcclusionMap),
+            "circles" => Ok(Overlay::Circles),
             _ => match s.strip_prefix("spheres:").map(str::parse::<u32>) {
                 Some(Ok(level)) if level <= 6 => Ok(Overlay::Spheres(level)),
                 _ => Err(format!(
-                    "unknown overlay '{s}': use spheres:LEVEL (0–6), contacts or occlusion-map"
+                    "unknown overlay '{s}': use spheres:LEVEL (0–6), contacts, occlusion-map or circles"
                 )),
             },
         }
@@ -61,20 +108,18 @@ impl Overlays {
             Overlay::Spheres(l) => self.sphere_level = Some(l),
             Overlay::Contacts => self.contacts = true,
             Overlay::OcclusionMap => self.occlusion_map = true,
+            Overlay::Circles => self.circles = true,
         }
         self
     }
 }
 
-/// Shows or hides each arch (extracted teeth stay hidden).
+/// Shows or hides each arch; extracted teeth are hidden.
 pub(super) fn arch_visibility(
     overlays: Res<Overlays>,
     mut teeth: Query<(&Tooth, &mut Visibility, Has<Extracted>)>,
-    added: Query<(), Added<Tooth>>,
 ) {
-    if !overlays.is_changed() && added.is_empty() {
-        return;
-    }
+    // Every frame: teeth are extracted and restored at any time, and there are at most 32.
     for (tooth, mut v, extracted) in &mut teeth {
         let hidden = extracted
             || match tooth.id.arch() {
@@ -113,11 +158,11 @@ impl Selection {
 
 const SELECTION_COLOUR: Color = Color::srgb(1.0, 0.85, 0.1);
 
-/// Rings around the selected teeth's crowns.
+/// Rings around the selected teeth's crowns (extracted ones are selected without a ring).
 pub(super) fn draw_selection(
     selection: Res<Selection>,
     mut gizmos: Gizmos,
-    teeth: Query<(&Transform, &crate::teeth::ToothShape)>,
+    teeth: Query<(&Transform, &crate::teeth::ToothShape), Without<Extracted>>,
 ) {
     for e in &selection.0 {
         let Ok((tf, shape)) = teeth.get(*e) else {
@@ -146,6 +191,45 @@ type TreeQuery<'w, 's> = Query<
     (Entity, &'static Transform, &'static ToothSphereTree),
     (With<Tooth>, Without<Extracted>),
 >;
+
+const CIRCLE_COLOUR: Color = Color::srgb(0.2, 0.9, 0.5);
+const CIRCLE_CONTACT_COLOUR: Color = Color::srgb(1.0, 0.2, 0.2);
+
+/// The bounding circles of the `circles` method, at each crown's height, red for pairs in contact.
+pub(super) fn draw_circles(
+    overlays: Res<Overlays>,
+    settings: Res<CollisionSettings>,
+    mut gizmos: Gizmos,
+    teeth: Query<(Entity, &Transform, &ToothCollider, &Visibility), Without<Extracted>>,
+    contacts: Res<Contacts>,
+) {
+    if !overlays.circles || settings.method != Method::Circles {
+        return;
+    }
+    for (e, tf, collider, visibility) in &teeth {
+        if *visibility == Visibility::Hidden {
+            continue;
+        }
+        let pose = Pose::new(tf.rotation, tf.translation);
+        let c = pose.transform_point(collider.circle.centre);
+        let height = pose
+            .transform_point(collider.shape.geometry.frame.crown_centre)
+            .y;
+        let touching = contacts.list.iter().any(|c| c.a == e || c.b == e);
+        gizmos.circle(
+            Isometry3d::new(
+                Vec3::new(c.x, height, c.z),
+                Quat::from_rotation_arc(Vec3::Z, Vec3::Y),
+            ),
+            collider.circle.radius,
+            if touching {
+                CIRCLE_CONTACT_COLOUR
+            } else {
+                CIRCLE_COLOUR
+            },
+        );
+    }
+}
 
 pub(super) fn draw_overlays(
     overlays: Res<Overlays>,
@@ -212,5 +296,16 @@ mod tests {
             .with(Overlay::Contacts);
         assert_eq!(o.sphere_level, Some(2));
         assert!(o.contacts);
+        assert_eq!("circles".parse::<Overlay>(), Ok(Overlay::Circles));
+        assert!(Overlays::default().with(Overlay::Circles).circles);
+    }
+
+    #[test]
+    fn root_styles_parse_and_default_to_translucent() {
+        assert_eq!(Overlays::default().roots, Roots::Translucent);
+        for r in Roots::ALL {
+            assert_eq!(r.name().parse::<Roots>(), Ok(r));
+        }
+        assert!("glass".parse::<Roots>().unwrap_err().contains("glass"));
     }
 }

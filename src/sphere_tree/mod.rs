@@ -34,6 +34,7 @@ pub use build::{TreeMethod, TreeSettings};
 pub use cache::{TreeCache, TreeSource};
 pub use coverage::{Coverage, check_coverage};
 pub use plugin::{
-    SphereTreeCache, SphereTreePlugin, SphereTreeSettings, SphereTreeSystems, ToothSphereTree,
+    SphereTreeCache, SphereTreePlugin, SphereTreeProgress, SphereTreeSettings, SphereTreeSystems,
+    ToothSphereTree,
 };
 pub use tree::SphereTree;

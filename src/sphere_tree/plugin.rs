@@ -28,6 +28,35 @@ pub struct SphereTreeSettings(pub TreeSettings);
 #[derive(Resource, Clone, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
 pub struct SphereTreeCache(pub Option<TreeCache>);
 
+/// How far the background builds have come, counted in distinct tooth shapes (teeth of one type
+/// share a tree), for progress readouts.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SphereTreeProgress {
+    /// Shapes whose tree is built.
+    pub built: usize,
+    /// Shapes whose tree is being built.
+    pub pending: usize,
+    /// Shapes whose tree could not be built.
+    pub failed: usize,
+}
+
+impl SphereTreeProgress {
+    /// True while some tree is being built.
+    pub fn busy(&self) -> bool {
+        self.pending > 0
+    }
+
+    /// Fraction of the started builds that have finished (1 when nothing was started).
+    pub fn fraction(&self) -> f32 {
+        let all = self.built + self.pending + self.failed;
+        if all == 0 {
+            1.0
+        } else {
+            (self.built + self.failed) as f32 / all as f32
+        }
+    }
+}
+
 /// A tooth's sphere tree (shared by teeth of the same shape).
 #[derive(Component, Clone, Debug, Deref)]
 pub struct ToothSphereTree(pub Arc<SphereTree>);
@@ -61,6 +90,7 @@ impl Plugin for SphereTreePlugin {
         app.init_resource::<SphereTreeSettings>()
             .init_resource::<SphereTreeCache>()
             .init_resource::<TreeStore>()
+            .init_resource::<SphereTreeProgress>()
             .configure_sets(
                 Update,
                 (SphereTreeSystems::Invalidate, SphereTreeSystems::Build).chain(),
@@ -71,7 +101,7 @@ impl Plugin for SphereTreePlugin {
                     invalidate_on_settings_change
                         .run_if(resource_changed::<SphereTreeSettings>)
                         .in_set(SphereTreeSystems::Invalidate),
-                    (finish_builds, start_builds_and_attach)
+                    (finish_builds, start_builds_and_attach, count_progress)
                         .chain()
                         .in_set(SphereTreeSystems::Build),
                 ),
@@ -117,6 +147,17 @@ fn finish_builds(mut store: ResMut<TreeStore>) {
                 store.failed.insert(k, geometry);
             }
         }
+    }
+}
+
+fn count_progress(store: Res<TreeStore>, mut progress: ResMut<SphereTreeProgress>) {
+    let now = SphereTreeProgress {
+        built: store.built.len(),
+        pending: store.pending.len(),
+        failed: store.failed.len(),
+    };
+    if *progress != now {
+        *progress = now;
     }
 }
 

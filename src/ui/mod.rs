@@ -13,9 +13,13 @@
 //! - **Teeth and loads**: select teeth by clicking them (shift-click for a group) or from an FDI
 //!   chart, and set a force or torque on them with presets along each tooth's mesial, buccal and
 //!   occlusal axes (mesial/distal, buccal/lingual, extrusion/intrusion, tipping, rotation, torque).
-//! - **View**: show or hide each arch.
+//!   The selected teeth can also get a round or rectangular wire, or be extracted and restored
+//!   while the case runs (a restore is refused, with the reason shown, when a tooth has moved into
+//!   the place).
+//! - **View**: show or hide each arch; roots translucent, solid or hidden.
 //! - **Overlays**: a sphere-tree level of every tooth, the contacts of the step, the occlusal
-//!   contact map.
+//!   contact map, the bounding circles while the circles algorithm is active.
+//! - Tree builds in the background show a progress bar.
 //!
 //! Camera input is ignored while the pointer is over the panel (see [`pointer_free`]).
 
@@ -25,14 +29,14 @@ use egui_plot::{HLine, Legend, Line, Plot, PlotPoints, Points};
 
 use crate::{
     collision::{CollisionSettings, Contacts, Method},
-    movement::SetLoad,
     movement::{
-        MovementSettings, MovementStatus, Response, SimulationState, report::pair_distances,
+        MovementSettings, MovementStatus, Response, SetExtracted, SetLoad, SetWire,
+        SimulationState, report::pair_distances,
     },
-    occlusion_view::Selection,
-    sphere_tree::{SphereTreeSettings, TreeMethod},
+    occlusion_view::{Roots, Selection},
+    sphere_tree::{SphereTreeProgress, SphereTreeSettings, TreeMethod},
     teeth::{ActiveCase, Case, LoadCase, Tooth},
-    teeth::{Extracted, Load},
+    teeth::{Extracted, Load, Wire, WireModel},
 };
 
 /// The panel and the simulation controls.
@@ -126,14 +130,37 @@ impl Default for LoadEditor {
     }
 }
 
+/// The teeth as the loads panel reads them.
+type PanelTeeth<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Tooth,
+        &'static Transform,
+        &'static Load,
+        Has<Extracted>,
+        Option<&'static Wire>,
+    ),
+>;
+
+/// What the loads panel asks of the simulation.
+#[derive(bevy::ecs::system::SystemParam)]
+struct ToothEdits<'w> {
+    load: MessageWriter<'w, SetLoad>,
+    wire: MessageWriter<'w, SetWire>,
+    extracted: MessageWriter<'w, SetExtracted>,
+}
+
 /// Selection (FDI chart) and loads on the selected teeth, with presets along each tooth's own
 /// mesial, buccal and occlusal axes.
 fn loads_panel(
     mut contexts: EguiContexts,
     mut editor: ResMut<LoadEditor>,
     mut selection: ResMut<Selection>,
-    teeth: Query<(Entity, &Tooth, &Transform, &Load, Has<Extracted>)>,
-    mut set: MessageWriter<SetLoad>,
+    teeth: PanelTeeth,
+    sim: Res<SimulationState>,
+    mut edits: ToothEdits,
 ) -> Result {
     let ctx = contexts.ctx_mut()?;
     egui::Window::new("Teeth and loads")
@@ -153,15 +180,18 @@ fn loads_panel(
                 ui.horizontal_wrapped(|ui| {
                     ui.spacing_mut().item_spacing.x = 2.0;
                     for n in row {
-                        let Some((e, _, _, _, extracted)) = find(n) else {
+                        let Some((e, _, _, _, extracted, _)) = find(n) else {
                             ui.add_enabled(false, egui::Button::new(n.to_string()).small());
                             continue;
                         };
                         let on = selection.0.contains(&e);
-                        let b = ui.add_enabled(
-                            !extracted,
-                            egui::Button::new(n.to_string()).small().selected(on),
-                        );
+                        let mut label = egui::RichText::new(n.to_string());
+                        if extracted {
+                            label = label.strikethrough().weak();
+                        }
+                        let b = ui
+                            .add(egui::Button::new(label).small().selected(on))
+                            .on_hover_text(if extracted { "extracted" } else { "" });
                         if b.clicked() {
                             selection.pick(e, true);
                         }
@@ -214,7 +244,7 @@ fn loads_panel(
             });
             if let Some((f, t)) = chosen {
                 for e in &selection.0 {
-                    let Ok((_, tooth, tf, current, _)) = teeth.get(*e) else {
+                    let Ok((_, tooth, tf, current, _, _)) = teeth.get(*e) else {
                         continue;
                     };
                     let axes = [
@@ -233,13 +263,47 @@ fn loads_panel(
                     if let Some((k, sign)) = t {
                         load.torque = axes[k] * sign * editor.torque_nmm;
                     }
-                    set.write(SetLoad { tooth: *e, load });
+                    edits.load.write(SetLoad { tooth: *e, load });
                 }
             }
+            ui.horizontal_wrapped(|ui| {
+                let any = !selection.0.is_empty();
+                for (label, wire) in [
+                    ("round wire", WireModel::Round),
+                    ("rectangular wire", WireModel::Rectangular),
+                ] {
+                    if ui.add_enabled(any, egui::Button::new(label)).clicked() {
+                        for e in &selection.0 {
+                            edits.wire.write(SetWire { tooth: *e, wire });
+                        }
+                    }
+                }
+                for (label, extracted) in [("extract", true), ("restore", false)] {
+                    if ui.add_enabled(any, egui::Button::new(label)).clicked() {
+                        for e in &selection.0 {
+                            edits.extracted.write(SetExtracted {
+                                tooth: *e,
+                                extracted,
+                            });
+                        }
+                    }
+                }
+            });
+            if let Some(notice) = &sim.notice {
+                ui.colored_label(egui::Color32::LIGHT_RED, notice);
+            }
             for e in &selection.0 {
-                if let Ok((_, tooth, _, l, _)) = teeth.get(*e) {
+                if let Ok((_, tooth, _, l, extracted, wire)) = teeth.get(*e) {
+                    if extracted {
+                        ui.label(format!("{}: extracted", tooth.id));
+                        continue;
+                    }
+                    let wire = match wire.map(|w| w.0) {
+                        Some(WireModel::Round) => "round",
+                        _ => "rectangular",
+                    };
                     ui.label(format!(
-                        "{}: force {:.2} N, torque {:.1} N·mm",
+                        "{}: force {:.2} N, torque {:.1} N·mm, {wire} wire",
                         tooth.id,
                         l.force.length(),
                         l.torque.length()
@@ -276,6 +340,7 @@ fn panel(
     teeth: Query<&Tooth>,
     mut load: MessageWriter<LoadCase>,
     mut overlays: ResMut<crate::occlusion_view::Overlays>,
+    progress: Res<SphereTreeProgress>,
 ) -> Result {
     let dt = real.delta_secs();
     if dt > 0.0 {
@@ -353,6 +418,9 @@ fn panel(
                 });
             if method != collision.method {
                 collision.method = method;
+                if method == Method::Circles {
+                    overlays.circles = true;
+                }
             }
             let mut response = movement.response;
             egui::ComboBox::from_label("response")
@@ -382,6 +450,26 @@ fn panel(
                 if let Some(name) = &current {
                     load.write(LoadCase(name.clone()));
                 }
+            }
+            if progress.busy() {
+                ui.add(
+                    egui::ProgressBar::new(progress.fraction())
+                        .text(format!(
+                            "building sphere trees: {} of {} tooth shapes",
+                            progress.built,
+                            progress.built + progress.pending + progress.failed
+                        ))
+                        .animate(true),
+                );
+            }
+            if progress.failed > 0 {
+                ui.colored_label(
+                    egui::Color32::LIGHT_RED,
+                    format!(
+                        "{} tree(s) could not be built (see the log)",
+                        progress.failed
+                    ),
+                );
             }
 
             ui.separator();
@@ -421,6 +509,30 @@ fn panel(
                     .changed()
                 {
                     overlays.occlusion_map = map;
+                }
+            });
+            ui.horizontal(|ui| {
+                let mut roots = overlays.roots;
+                egui::ComboBox::from_label("roots")
+                    .selected_text(roots.name())
+                    .show_ui(ui, |ui| {
+                        for r in Roots::ALL {
+                            ui.selectable_value(&mut roots, r, r.name());
+                        }
+                    });
+                if roots != overlays.roots {
+                    overlays.roots = roots;
+                }
+                let mut circles = overlays.circles;
+                if ui
+                    .add_enabled(
+                        collision.method == Method::Circles,
+                        egui::Checkbox::new(&mut circles, "bounding circles"),
+                    )
+                    .on_disabled_hover_text("drawn while the circles algorithm is active")
+                    .changed()
+                {
+                    overlays.circles = circles;
                 }
             });
 

@@ -441,3 +441,150 @@ fn a_load_set_by_message_moves_its_tooth() {
         Vec3::new(0.0, 0.0, 1.5)
     );
 }
+
+/// Extracting and restoring teeth while a case runs keeps the other teeth where they are, and a
+/// restore is refused once a neighbour has moved into the tooth's place.
+#[test]
+fn teeth_are_extracted_and_restored_while_the_case_runs() {
+    let d = Dentition::build(Case::resolve("case1").unwrap()).unwrap();
+    let shapes = collision_shapes(&d, medial(), Some(cache())).unwrap();
+    let shape_of = |n: u8| {
+        shapes
+            .iter()
+            .find(|(f, _)| f.number() == n)
+            .map(|(_, s)| s.clone())
+    };
+    // collision_shapes covers the visible teeth only: the extracted premolars share the shape of
+    // the second premolars of their arch side's type, so build theirs from the normal case.
+    let normal = Dentition::build(Case::resolve("normal").unwrap()).unwrap();
+    let all = collision_shapes(&normal, medial(), Some(cache())).unwrap();
+    let shape_14 = all
+        .iter()
+        .find(|(f, _)| f.number() == 14)
+        .map(|(_, s)| s.clone());
+    let mut sim = Simulation::new(
+        &d,
+        shapes.clone(),
+        Method::Continuous,
+        settings(Response::Block),
+    )
+    .unwrap();
+    let fdi = |n: u8| Fdi::new(n as i64).unwrap();
+    assert_eq!(sim.teeth.len(), 28);
+    for _ in 0..5 {
+        sim.step();
+    }
+
+    // Errors: not in the case, already extracted, already present, no shape.
+    let mut without_18 = d.clone();
+    without_18.teeth.retain(|t| t.fdi != fdi(18));
+    let absent = sim
+        .with_extraction(&without_18, fdi(18), true, None)
+        .unwrap_err();
+    assert!(absent.contains("not in the case"), "{absent}");
+    let again = sim.with_extraction(&d, fdi(14), true, None).unwrap_err();
+    assert!(again.contains("already extracted"), "{again}");
+    let present = sim
+        .with_extraction(&d, fdi(15), false, shape_of(15))
+        .unwrap_err();
+    assert!(present.contains("already in place"), "{present}");
+    assert!(sim.with_extraction(&d, fdi(14), false, None).is_err());
+
+    // Extract 15: the others stay put with their loads, displacements and the step count.
+    let extracted = sim.with_extraction(&d, fdi(15), true, None).unwrap();
+    assert_eq!(extracted.teeth.len(), 27);
+    assert!(extracted.index_of(fdi(15)).is_none());
+    assert_eq!(extracted.steps, sim.steps);
+    for t in &extracted.teeth {
+        let old = &sim.teeth[sim.index_of(t.fdi).unwrap()];
+        assert_eq!(t.pose, old.pose, "{}", t.fdi);
+        assert_eq!(t.initial, old.initial, "{}", t.fdi);
+        assert_eq!(t.load, old.load, "{}", t.fdi);
+    }
+
+    // Restore 14 before anything has moved into its place: it comes back where the case had it.
+    let restored = sim
+        .with_extraction(&d, fdi(14), false, shape_14.clone())
+        .unwrap();
+    assert_eq!(restored.teeth.len(), 29);
+    let i = restored.index_of(fdi(14)).unwrap();
+    assert_eq!(restored.teeth[i].pose, d.tooth(fdi(14)).unwrap().pose);
+    assert_eq!(max_penetration(&restored), 0.0);
+
+    // Once the molar has pushed the premolar into the extraction space, 14 cannot come back.
+    let i15 = sim.index_of(fdi(15)).unwrap();
+    while sim.teeth[i15].displacement_mm() < 1.0 && sim.steps < 3000 {
+        sim.step();
+    }
+    assert!(sim.teeth[i15].displacement_mm() >= 1.0);
+    let refused = sim
+        .with_extraction(&d, fdi(14), false, shape_14)
+        .unwrap_err();
+    assert!(refused.contains("15 has moved into its place"), "{refused}");
+}
+
+#[test]
+fn wires_extractions_and_restorations_by_message() {
+    use orthosim::movement::{SetExtracted, SetWire};
+    use orthosim::teeth::{Extracted, Wire, WireModel};
+    let mut app = create_app();
+    app.world_mut().write_message(LoadCase("normal".into()));
+    for _ in 0..3000 {
+        app.update();
+        if app.world().resource::<SimulationState>().sim.is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let mut q = app.world_mut().query::<(Entity, &Tooth)>();
+    let mut find = |app: &mut App, n: u8| {
+        q.iter(app.world())
+            .find(|(_, t)| t.id.number() == n)
+            .map(|(e, _)| e)
+            .unwrap()
+    };
+    let e12 = find(&mut app, 12);
+    let e13 = find(&mut app, 13);
+    let teeth = |app: &App| {
+        app.world()
+            .resource::<SimulationState>()
+            .sim
+            .as_ref()
+            .map(|s| s.teeth.len())
+    };
+    let before = teeth(&app).unwrap();
+
+    app.world_mut().write_message(SetWire {
+        tooth: e13,
+        wire: WireModel::Round,
+    });
+    app.world_mut().write_message(SetExtracted {
+        tooth: e12,
+        extracted: true,
+    });
+    app.world_mut().run_schedule(FixedUpdate);
+    app.update();
+    assert_eq!(teeth(&app), Some(before - 1));
+    assert!(app.world().get::<Extracted>(e12).is_some());
+    assert_eq!(app.world().get::<Wire>(e13), Some(&Wire(WireModel::Round)));
+    let state = app.world().resource::<SimulationState>();
+    let sim = state.sim.as_ref().unwrap();
+    let i13 = sim.index_of(Fdi::new(13).unwrap()).unwrap();
+    assert_eq!(sim.teeth[i13].wire, WireModel::Round);
+    assert_eq!(state.entities.len(), sim.teeth.len());
+    assert_eq!(state.index_of(e13), Some(i13));
+
+    // Steps run with the tooth gone, and it comes back in place.
+    for _ in 0..5 {
+        app.world_mut().run_schedule(FixedUpdate);
+    }
+    app.world_mut().write_message(SetExtracted {
+        tooth: e12,
+        extracted: false,
+    });
+    app.world_mut().run_schedule(FixedUpdate);
+    app.update();
+    assert_eq!(teeth(&app), Some(before));
+    assert!(app.world().get::<Extracted>(e12).is_none());
+    assert!(app.world().resource::<SimulationState>().notice.is_none());
+}

@@ -89,3 +89,56 @@ fn the_occlusion_map_colours_the_teeth() {
     let share = blue as f64 / pixels.len() as f64;
     assert!(share > 0.03, "blue share {share}");
 }
+
+/// Pixels that differ clearly from the dark background (teeth, roots, overlays).
+fn drawn(buf: &[u8], channels: usize) -> usize {
+    buf.chunks(channels)
+        .filter(|p| p[..3].iter().map(|&c| c as u32).sum::<u32>() > 3 * 70)
+        .count()
+}
+
+#[test]
+fn roots_hide_and_bounding_circles_show() {
+    if !have_xvfb() {
+        return;
+    }
+    let (_, _, channels, solid) = shoot(
+        "solid-roots",
+        &["--case", "normal", "--view", "right", "--roots", "solid"],
+    );
+    let (_, _, _, hidden) = shoot(
+        "circles",
+        &[
+            "--case",
+            "normal",
+            "--view",
+            "right",
+            "--roots",
+            "hidden",
+            "--algorithm",
+            "circles",
+            "--overlay",
+            "circles",
+        ],
+    );
+    // Without roots much less of the picture is tooth.
+    let (with_roots, without) = (drawn(&solid, channels), drawn(&hidden, channels));
+    assert!(
+        (without as f64) < 0.8 * with_roots as f64,
+        "{without} drawn pixels without roots, {with_roots} with"
+    );
+    // The circles are drawn in green (red where a pair's circles meet).
+    let green = |buf: &[u8]| {
+        buf.chunks(channels)
+            .filter(|p| {
+                p[1] > 150 && p[1] as i32 > p[0] as i32 + 60 && p[1] as i32 > p[2] as i32 + 40
+            })
+            .count()
+    };
+    assert!(green(&hidden) > 200, "{} green pixels", green(&hidden));
+    assert!(
+        green(&solid) < green(&hidden) / 4,
+        "{} green pixels",
+        green(&solid)
+    );
+}
