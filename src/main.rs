@@ -51,11 +51,19 @@ enum Command {
         #[arg(long, value_enum, default_value_t = TreeMethod::Medial)]
         tree: TreeMethod,
         /// Overlays: `spheres:LEVEL` (a sphere-tree level, 0 = root), `contacts` (overlapping leaf
-        /// spheres and contact points of the step) or `occlusion-map` (surfaces coloured by their
-        /// distance to the opposing arch); repeat for several.
+        /// spheres and contact points of the step), `occlusion-map` (surfaces coloured by their
+        /// distance to the opposing arch) or `circles` (bounding circles, with `--algorithm
+        /// circles`); repeat for several.
         #[cfg(feature = "viewer")]
         #[arg(long)]
         overlay: Vec<orthosim::occlusion_view::Overlay>,
+        /// Narrow-phase method of the simulation.
+        #[arg(long, value_enum, default_value_t = Method::Continuous)]
+        algorithm: Method,
+        /// How roots are drawn: translucent, solid or hidden.
+        #[cfg(feature = "viewer")]
+        #[arg(long, default_value = "translucent")]
+        roots: orthosim::occlusion_view::Roots,
         /// Hide an arch (`upper` or `lower`), e.g. to see the other one's occlusal surface.
         #[arg(long, value_parser = ["upper", "lower"])]
         hide: Vec<String>,
@@ -128,6 +136,16 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(20..=200_000))]
         resolution: Option<u32>,
     },
+    /// Write a case as one STL file per tooth plus a RON case file that names them (a template
+    /// for patient cases, and the import path's round trip).
+    ExportCase {
+        /// Built-in case name or path to a .ron case file.
+        #[arg(long, default_value = "normal")]
+        case: String,
+        /// Folder to write into (created if needed).
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// Build each tooth's sphere tree and report its fit (the paper's relative outside volume).
     Trees {
         /// Built-in case name or path to a .ron case file.
@@ -168,6 +186,10 @@ enum Command {
         /// Seed of the motions.
         #[arg(long, default_value_t = 0x5eed)]
         seed: u64,
+        /// Tooth mesh resolution: `default` (the case's), `high` (scan resolution: 10,100
+        /// vertices, about 20,000 triangles per tooth) or a number of vertices per tooth.
+        #[arg(long, default_value = "default")]
+        resolution: BenchResolution,
         /// Build every tree afresh instead of using the user's tree cache.
         #[arg(long)]
         no_cache: bool,
@@ -214,9 +236,17 @@ fn main() -> ExitCode {
             pairs,
             tree,
             seed,
+            resolution,
             no_cache,
             json,
-        } => run_bench(&case, pairs as usize, tree, seed, no_cache, json),
+        } => run_bench(
+            &case,
+            pairs as usize,
+            tree,
+            (seed, resolution),
+            no_cache,
+            json,
+        ),
         Command::Simulate {
             case,
             algorithm,
@@ -251,11 +281,23 @@ fn main() -> ExitCode {
             frames,
             tree,
             overlay,
+            algorithm,
+            roots,
             hide,
             out,
-        } => screenshot(&case, view, frames, tree, &overlay, &hide, &out),
+        } => screenshot(
+            &case,
+            view,
+            frames,
+            tree,
+            &overlay,
+            (algorithm, roots),
+            &hide,
+            &out,
+        ),
         #[cfg(not(feature = "viewer"))]
         Command::Screenshot { .. } => view("none"),
+        Command::ExportCase { case, out } => run_export_case(&case, &out),
         Command::Cases => {
             list_cases();
             Ok(())
@@ -275,16 +317,45 @@ fn main() -> ExitCode {
     }
 }
 
+/// `bench --resolution`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum BenchResolution {
+    /// The case's own.
+    Default,
+    /// Vertices per procedural tooth.
+    Vertices(u32),
+}
+
+impl std::str::FromStr for BenchResolution {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "default" => Ok(Self::Default),
+            "high" => Ok(Self::Vertices(10_100)),
+            _ => match s.parse::<u32>() {
+                Ok(n) if (20..=200_000).contains(&n) => Ok(Self::Vertices(n)),
+                _ => Err(format!(
+                    "'{s}': use default, high or a number of vertices per tooth (20–200000)"
+                )),
+            },
+        }
+    }
+}
+
 fn run_bench(
     case: &str,
     pairs: usize,
     tree: TreeMethod,
-    seed: u64,
+    (seed, resolution): (u64, BenchResolution),
     no_cache: bool,
     json: bool,
 ) -> Result<()> {
     use orthosim::collision::bench;
-    let dentition = Dentition::build(Case::resolve(case)?)?;
+    let mut loaded = Case::resolve(case)?;
+    if let BenchResolution::Vertices(n) = resolution {
+        loaded.case.resolution = Some(n);
+    }
+    let dentition = Dentition::build(loaded)?;
     let settings = TreeSettings {
         method: tree,
         branching: 8,
@@ -526,6 +597,18 @@ fn list_cases() {
     }
 }
 
+fn run_export_case(case: &str, out: &std::path::Path) -> Result<()> {
+    let d = Dentition::build(Case::resolve(case)?)?;
+    let report = orthosim::teeth::import::export_case(&d, out).map_err(anyhow::Error::msg)?;
+    println!(
+        "wrote {} ({} teeth, {} triangles)",
+        report.case_file.display(),
+        report.meshes.len(),
+        report.triangles
+    );
+    Ok(())
+}
+
 fn run_inspect(case: &str, json: bool, resolution: Option<u32>) -> Result<()> {
     let mut loaded = Case::resolve(case)?;
     if resolution.is_some() {
@@ -570,6 +653,12 @@ fn run_inspect(case: &str, json: bool, resolution: Option<u32>) -> Result<()> {
             c[2],
             if t.extracted { "  extracted" } else { "" }
         );
+    }
+    if !report.imported.is_empty() {
+        println!("teeth read from mesh files (repairs):");
+        for m in &report.imported {
+            println!("  {}: {}", m.fdi, m.summary);
+        }
     }
     println!("neighbour gaps (mm):");
     for g in &report.neighbour_gaps_mm {
@@ -700,21 +789,27 @@ fn screenshot(
     frames: u32,
     tree: TreeMethod,
     overlays: &[orthosim::occlusion_view::Overlay],
+    (algorithm, roots): (Method, orthosim::occlusion_view::Roots),
     hide: &[String],
     out: &std::path::Path,
 ) -> Result<()> {
-    use orthosim::occlusion_view::{OcclusionViewPlugin, ScreenshotOutcome, ScreenshotPlugin};
+    use orthosim::{
+        collision::CollisionSettings,
+        occlusion_view::{OcclusionViewPlugin, ScreenshotOutcome, ScreenshotPlugin},
+    };
     Case::resolve(case)?;
     if out.extension().and_then(|e| e.to_str()) != Some("png") {
         anyhow::bail!("{}: the screenshot must be a .png file", out.display());
     }
     let shared = std::sync::Arc::new(std::sync::Mutex::new(ScreenshotOutcome::default()));
     let mut app = window_app(case, format!("orthosim: {case}"), tree);
+    app.insert_resource(CollisionSettings { method: algorithm });
     app.add_plugins(OcclusionViewPlugin {
         initial_view: camera,
         overlays: orthosim::occlusion_view::Overlays {
             hide_upper: hide.iter().any(|h| h == "upper"),
             hide_lower: hide.iter().any(|h| h == "lower"),
+            roots,
             ..overlays.iter().fold(
                 Default::default(),
                 |o: orthosim::occlusion_view::Overlays, x| o.with(*x),

@@ -69,6 +69,19 @@ pub struct InspectReport {
     pub occlusal_min_gap_mm: f32,
     /// Overjet, overbite and molar relation of the underlying arrangement.
     pub occlusion: OcclusionMeasures,
+    /// Teeth read from mesh files, with what was repaired in each.
+    pub imported: Vec<ImportedMesh>,
+}
+
+/// A tooth read from a mesh file.
+#[derive(Clone, Debug, Serialize)]
+pub struct ImportedMesh {
+    /// FDI number.
+    pub fdi: u8,
+    /// One line: what was repaired ("nothing" when the mesh was clean).
+    pub summary: String,
+    /// The repairs in detail.
+    pub repairs: crate::teeth::import::Repairs,
 }
 
 fn signed_gap(a: &PlacedTooth, b: &PlacedTooth) -> f32 {
@@ -156,6 +169,15 @@ pub fn inspect(d: &Dentition) -> InspectReport {
         occlusal_max_penetration_mm: occlusal,
         occlusal_min_gap_mm: occlusal_gap,
         occlusion: d.arrangement,
+        imported: d
+            .imported
+            .iter()
+            .map(|(f, r)| ImportedMesh {
+                fdi: f.number(),
+                summary: r.summary(),
+                repairs: r.clone(),
+            })
+            .collect(),
     }
 }
 

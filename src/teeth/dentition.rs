@@ -6,9 +6,10 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::{
-    arch::{ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces},
-    case::{CaseError, CaseVector, LoadedCase, WireModel},
+    arch::{ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces},
+    case::{Case, CaseError, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
+    import::{RepairLimits, Repairs, import_tooth},
     tooth_shape::{ShapeSet, ToothGeometry},
 };
 use crate::geometry::Pose;
@@ -91,6 +92,8 @@ pub struct Dentition {
     /// The arch forms the teeth's cervical centres were placed on: upper, then lower (the upper
     /// one at the arrangement's height; the bite opening raises the teeth, not the curve in x–z).
     pub arch_forms: [BetaArch; 2],
+    /// What was repaired in each imported tooth mesh (teeth with a mesh file only).
+    pub imported: std::collections::BTreeMap<Fdi, Repairs>,
 }
 
 impl Dentition {
@@ -114,6 +117,33 @@ impl Dentition {
                 wire: case.wire_of(fdi),
             })
             .collect();
+        let arch_forms = [arrangement.upper, ArchLayout::default().lower];
+        let mut imported_repairs = std::collections::BTreeMap::new();
+        if !case.meshes.0.is_empty() {
+            let curves = arch_forms.map(|f| ArchCurve::new(&f));
+            let files: Vec<_> = case.meshes.0.iter().collect();
+            let limits = RepairLimits::default();
+            let imported = crate::parallel::parallel_map(&files, |(fdi, spec)| {
+                let path = Case::mesh_path(&loaded.origin, &spec.file);
+                let curve = &curves[usize::from(fdi.arch() == Arch::Lower)];
+                import_tooth(&path, spec, **fdi, curve, &limits).map_err(|message| {
+                    CaseError::Mesh {
+                        path: path.display().to_string(),
+                        fdi: **fdi,
+                        case: loaded.origin.clone(),
+                        message,
+                    }
+                })
+            });
+            for ((fdi, _), result) in files.iter().zip(imported) {
+                let tooth = result?;
+                if let Some(t) = teeth.iter_mut().find(|t| t.fdi == **fdi) {
+                    t.geometry = Arc::new(tooth.geometry);
+                    t.pose = tooth.pose;
+                }
+                imported_repairs.insert(**fdi, tooth.repairs);
+            }
+        }
         let lift = Vec3::Y * case.bite_opening_mm.0;
         for tooth in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Upper) {
             tooth.pose.translation += lift;
@@ -160,7 +190,8 @@ impl Dentition {
             teeth,
             groups,
             arrangement: arrangement.measures,
-            arch_forms: [arrangement.upper, ArchLayout::default().lower],
+            arch_forms,
+            imported: imported_repairs,
         })
     }
 

@@ -11,6 +11,7 @@ pub mod components;
 pub mod dentition;
 pub mod fdi;
 pub mod frame;
+pub mod import;
 mod memo;
 pub mod plugin;
 pub mod shape;

@@ -58,6 +58,29 @@ impl ToothGeometry {
         }
     }
 
+    /// The geometry of an imported tooth from its closed mesh in its local frame (origin at the
+    /// cervical centre, y occlusal, z buccal; see [`super::import`]). Dimensions are the anatomy
+    /// table's for the type.
+    pub fn imported(arch: Arch, kind: ToothKind, mesh: TriMesh) -> Self {
+        let frame = ToothFrame::from_mesh(
+            &mesh,
+            Vec3::ZERO,
+            Vec3::Y,
+            Vec3::Z,
+            CentreParameters::default(),
+        );
+        let bvh = TriangleBvh::build(&mesh);
+        Self {
+            arch,
+            kind,
+            anatomy: anatomy(arch, kind),
+            cusp_tips: super::import::cusp_tips(&mesh, kind),
+            mesh,
+            bvh,
+            frame,
+        }
+    }
+
     /// The mesh with its hierarchy, for geometry queries.
     pub fn mesh_ref(&self) -> MeshRef<'_> {
         MeshRef {

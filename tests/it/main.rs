@@ -4,6 +4,7 @@ mod cli;
 mod collision;
 mod ecs;
 mod geometry_props;
+mod import;
 mod movement;
 mod oracle;
 mod parry_support;

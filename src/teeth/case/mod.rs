@@ -64,6 +64,18 @@ pub enum CaseError {
         /// What is wrong.
         message: String,
     },
+    /// A tooth's mesh file could not be imported.
+    #[error("{path}: {message} (tooth {fdi}, named in {case})")]
+    Mesh {
+        /// The mesh file.
+        path: String,
+        /// The tooth.
+        fdi: Fdi,
+        /// The case file that names it.
+        case: String,
+        /// What is wrong, and where in the mesh.
+        message: String,
+    },
     /// The name is neither a built-in case nor an existing file.
     #[error(
         "unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file"
@@ -110,9 +122,11 @@ pub struct Case {
     /// against any movement along them). Default 0: the arches in occlusion.
     #[serde(default)]
     pub bite_opening_mm: NonNegative,
-    /// Mesh files per tooth, relative to the case file (mesh import is a later feature).
+    /// Mesh files per tooth (STL, OBJ or PLY), paths relative to the case file, e.g.
+    /// `{11: (file: "11.stl")}` or `{11: (file: "11.obj", units: Metres, transform: (translation:
+    /// (0.0, 2.0, 0.0)))}`; see [`crate::teeth::import`]. Other teeth are procedural.
     #[serde(default)]
-    pub meshes: ToothMap<String>,
+    pub meshes: ToothMap<crate::teeth::import::ToothMeshFile>,
 }
 
 /// A case with where it came from.
@@ -204,6 +218,18 @@ impl Case {
     /// True when the tooth is present and extracted.
     pub fn is_extracted(&self, f: Fdi) -> bool {
         self.extracted.0.contains(&f)
+    }
+
+    /// Where a mesh file named in the case is: relative paths are taken from the case file's
+    /// folder (from the working folder for a built-in case).
+    pub fn mesh_path(origin: &str, file: &str) -> std::path::PathBuf {
+        let file = Path::new(file);
+        if file.is_absolute() || origin.starts_with("builtin:") {
+            return file.to_owned();
+        }
+        Path::new(origin)
+            .parent()
+            .map_or_else(|| file.to_owned(), |dir| dir.join(file))
     }
 
     /// The mesh resolution asked for.
@@ -308,12 +334,17 @@ impl Case {
         for f in self.meshes.0.keys() {
             absent("meshes", f)?;
         }
-        if let Some(f) = self.meshes.0.keys().next() {
-            return Err((
-                "meshes",
-                Some(f.to_string()),
-                "per-tooth mesh files are not supported yet; remove `meshes` to use procedural teeth".into(),
-            ));
+        for (f, m) in &self.meshes.0 {
+            if m.file.trim().is_empty() {
+                return Err((
+                    "meshes",
+                    Some(f.to_string()),
+                    format!("the mesh file of tooth {f} is empty"),
+                ));
+            }
+            if let Err(e) = crate::teeth::import::MeshFormat::of(Path::new(&m.file)) {
+                return Err(("meshes", Some(m.file.clone()), format!("{}: {e}", m.file)));
+            }
         }
         for load in &self.loads {
             if load.teeth.0.is_empty() {

@@ -1,0 +1,306 @@
+//! Real patients: tooth meshes from segmentation software (STL, OBJ, PLY), one file per tooth.
+//!
+//! A case names a file per tooth in `meshes` (paths relative to the case file), each with its
+//! units (millimetres by default; metres and inches are converted) and an optional transform
+//! (rotation in degrees about x, then y, then z, then translation in mm) that brings the scan into
+//! orthosim's frame: millimetres, y towards the upper arch, z forwards (labial at the incisors), x
+//! towards the patient's left, the origin between the arches at the midline.
+//!
+//! Each mesh is checked and repaired ([`repair`]: welding, degenerate and duplicated triangles,
+//! winding, small holes, debris), and refused with the reason and a position when it cannot be
+//! (empty, NaN, non-manifold, open beyond the hole limit, several teeth in one file, self-
+//! intersecting). A scanned crown (one large opening, at the gum line) gets a generated root
+//! ([`root`]). The tooth's frame then comes from the mesh where the scan put it:
+//!
+//! - long axis (local y): the principal axis of inertia closest to the arch's occlusal direction
+//!   (+y for the lower arch, −y for the upper), pointing occlusally;
+//! - buccal axis (local z): the outward normal of the case's arch curve at the tooth, made
+//!   perpendicular to the long axis; local x = y × z;
+//! - origin: the cervical centre: the centroid of the margin for a scanned crown, else the point of
+//!   the long axis one crown length (anatomy table) below the crown's highest point.
+//!
+//! So loads, wire models, constraints and the analysis work on imported teeth as on procedural
+//! ones; the tooth stands exactly where the scan has it (its pose maps the local mesh back).
+
+pub mod export;
+pub mod read;
+pub mod repair;
+pub mod root;
+
+use std::path::Path;
+
+use glam::{Mat3, Quat, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+use super::{
+    anatomy::anatomy,
+    arch::ArchCurve,
+    case::Finite,
+    fdi::{Arch, Fdi, ToothKind},
+    tooth_shape::ToothGeometry,
+};
+use crate::geometry::{MassProperties, MeshError, Pose, TriMesh};
+
+pub use export::{ExportReport, export_case};
+pub use read::{MeshFormat, read_mesh, write_stl};
+pub use repair::{RepairLimits, Repairs};
+
+/// Units of a mesh file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Units {
+    /// Millimetres (what segmentation software usually writes).
+    #[default]
+    Millimetres,
+    /// Metres.
+    Metres,
+    /// Inches.
+    Inches,
+}
+
+impl Units {
+    /// Millimetres per unit.
+    pub fn mm(self) -> f32 {
+        match self {
+            Units::Millimetres => 1.0,
+            Units::Metres => 1000.0,
+            Units::Inches => 25.4,
+        }
+    }
+}
+
+/// A rigid transform applied to a mesh after unit conversion: rotation (degrees about x, then y,
+/// then z), then translation (mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshTransform {
+    /// Translation (mm).
+    #[serde(default)]
+    pub translation: (Finite, Finite, Finite),
+    /// Rotation (degrees) about x, y and z, applied in that order.
+    #[serde(default)]
+    pub rotation_deg: (Finite, Finite, Finite),
+}
+
+impl MeshTransform {
+    /// The transform as a pose.
+    pub fn pose(&self) -> Pose {
+        let (rx, ry, rz) = self.rotation_deg;
+        let rotation = Quat::from_rotation_z(rz.0.to_radians())
+            * Quat::from_rotation_y(ry.0.to_radians())
+            * Quat::from_rotation_x(rx.0.to_radians());
+        let (x, y, z) = self.translation;
+        Pose::new(rotation, Vec3::new(x.0, y.0, z.0))
+    }
+}
+
+/// A tooth's mesh file in a case.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToothMeshFile {
+    /// Path, relative to the case file.
+    pub file: String,
+    /// Units of the file's coordinates.
+    #[serde(default)]
+    pub units: Units,
+    /// Transform into orthosim's frame.
+    #[serde(default)]
+    pub transform: MeshTransform,
+}
+
+/// A single large opening is taken for a crown's cervical margin (and closed by a generated root)
+/// only when the direction away from the crown through it is within 60° of the arch's apical
+/// direction.
+pub const MARGIN_COS: f32 = 0.5;
+
+/// An imported tooth: its geometry in its own frame and where the scan put it.
+#[derive(Debug)]
+pub struct ImportedTooth {
+    /// Geometry in the tooth's local frame.
+    pub geometry: ToothGeometry,
+    /// Pose of the local frame (orthosim's world frame).
+    pub pose: Pose,
+    /// What was repaired.
+    pub repairs: Repairs,
+}
+
+/// Reads, repairs and frames the mesh of tooth `fdi` from `path`; `curve` is the arch curve of
+/// the tooth's arch (for its buccal direction). Errors say what is wrong and where, without the
+/// path.
+pub fn import_tooth(
+    path: &Path,
+    spec: &ToothMeshFile,
+    fdi: Fdi,
+    curve: &ArchCurve,
+    limits: &RepairLimits,
+) -> Result<ImportedTooth, String> {
+    let raw = read_mesh(path)?;
+    let transform = spec.transform.pose();
+    let scale = spec.units.mm();
+    let world = raw.map_vertices(|v| transform.transform_point(v * scale));
+    import_mesh(&world, fdi, curve, limits)
+}
+
+/// [`import_tooth`] for a mesh already read, in orthosim's frame (mm).
+pub fn import_mesh(
+    world: &TriMesh,
+    fdi: Fdi,
+    curve: &ArchCurve,
+    limits: &RepairLimits,
+) -> Result<ImportedTooth, String> {
+    let an = anatomy(fdi.arch(), fdi.kind());
+    let mut repairs = Repairs::default();
+    let open = repair::clean(world, limits, &mut repairs)?;
+    let mut mesh = open.mesh;
+    let cervical = match open.loops.as_slice() {
+        [] => None,
+        [margin] => {
+            let length = repair::loop_length(&mesh, margin);
+            let (centre, apical) = root::close_with_root(&mut mesh, margin, an.root_length)?;
+            // A crown's margin faces away from the occlusal surface: any other large opening is a
+            // hole, not a missing root.
+            if apical.dot(-occlusal_direction(fdi.arch())) < MARGIN_COS {
+                return Err(format!(
+                    "the mesh is open: an opening with a {length:.2} mm boundary {} is beyond the \
+                     {} mm closed automatically, and it does not face the root's side as a \
+                     crown's margin does",
+                    near(mesh.vertices[margin[0] as usize]),
+                    limits.max_hole_mm
+                ));
+            }
+            repairs.root_generated_margin_mm = Some(length);
+            Some(centre)
+        }
+        loops => {
+            let (l, length) = loops
+                .iter()
+                .map(|l| (l, repair::loop_length(&mesh, l)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("several loops");
+            return Err(format!(
+                "the mesh is open: {} openings, the smallest with a {length:.2} mm boundary {}, \
+                 beyond the {} mm closed automatically (a scanned crown has one opening, at the \
+                 gum line)",
+                loops.len(),
+                near(mesh.vertices[l[0] as usize]),
+                limits.max_hole_mm
+            ));
+        }
+    };
+    if mesh.signed_volume() < 0.0 {
+        for t in &mut mesh.triangles {
+            t.swap(1, 2);
+        }
+        repairs.turned_outward = true;
+    }
+    mesh.validate_solid().map_err(|e| explain(&mesh, e))?;
+    let pose = tooth_pose(&mesh, fdi, curve, cervical, an.crown_length);
+    let inverse = pose.inverse();
+    let local = mesh.map_vertices(|v| inverse.transform_point(v));
+    let geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
+    Ok(ImportedTooth {
+        geometry,
+        pose,
+        repairs,
+    })
+}
+
+fn near(v: Vec3) -> String {
+    format!("near ({:.3}, {:.3}, {:.3}) mm", v.x, v.y, v.z)
+}
+
+/// A mesh error with the place it is at.
+fn explain(mesh: &TriMesh, e: MeshError) -> String {
+    let centre = |t: usize| {
+        let [a, b, c] = mesh.triangle(t);
+        (a + b + c) / 3.0
+    };
+    match e {
+        MeshError::SelfIntersecting { a, b } => format!(
+            "the mesh intersects itself: triangles {a} and {b} cross {}",
+            near(centre(a))
+        ),
+        MeshError::Degenerate { triangle, .. } => format!(
+            "a degenerate triangle remains after repair {}",
+            near(centre(triangle))
+        ),
+        MeshError::Inverted { volume } => {
+            format!("the mesh encloses no volume ({volume:.4} mm³): it is flat")
+        }
+        other => format!("the repaired mesh is not a closed solid: {other}"),
+    }
+}
+
+/// The occlusal direction of an arch in orthosim's frame.
+pub fn occlusal_direction(arch: Arch) -> Vec3 {
+    match arch {
+        Arch::Upper => Vec3::NEG_Y,
+        Arch::Lower => Vec3::Y,
+    }
+}
+
+/// The frame of a tooth mesh placed in the world (see the module doc).
+fn tooth_pose(
+    mesh: &TriMesh,
+    fdi: Fdi,
+    curve: &ArchCurve,
+    cervical: Option<Vec3>,
+    crown_length: f32,
+) -> Pose {
+    let occlusal = occlusal_direction(fdi.arch());
+    let mass = MassProperties::of(mesh);
+    let (_, axes) = mass.principal_axes();
+    let mut y = [axes.x_axis, axes.y_axis, axes.z_axis]
+        .into_iter()
+        .max_by(|a, b| a.dot(occlusal).abs().total_cmp(&b.dot(occlusal).abs()))
+        .unwrap_or(occlusal);
+    if y.dot(occlusal) < 0.0 {
+        y = -y;
+    }
+    let com = mass.centre_of_mass;
+    let origin = cervical.unwrap_or_else(|| {
+        let top = mesh
+            .vertices
+            .iter()
+            .map(|v| v.dot(y))
+            .fold(f32::NEG_INFINITY, f32::max);
+        com + y * (top - crown_length - com.dot(y))
+    });
+    let s = curve.project(Vec2::new(com.x, com.z));
+    let (_, tangent) = curve.at(s);
+    let outward = Vec3::new(-tangent.y, 0.0, tangent.x);
+    let z = (outward - y * outward.dot(y)).normalize_or(Vec3::Z);
+    let x = y.cross(z).normalize();
+    let z = x.cross(y);
+    Pose::new(
+        Quat::from_mat3(&Mat3::from_cols(x, y, z)).normalize(),
+        origin,
+    )
+}
+
+/// Cusp tips (local frame) of an imported tooth: the highest vertex of each of the type's cusp
+/// regions (one for incisors and canines, buccal and lingual halves for premolars, four quadrants
+/// for molars).
+pub(super) fn cusp_tips(mesh: &TriMesh, kind: ToothKind) -> Vec<Vec3> {
+    let regions: &[fn(Vec3) -> bool] = match kind {
+        ToothKind::CentralIncisor | ToothKind::LateralIncisor | ToothKind::Canine => &[|_| true],
+        ToothKind::FirstPremolar | ToothKind::SecondPremolar => {
+            &[|v: Vec3| v.z >= 0.0, |v: Vec3| v.z < 0.0]
+        }
+        _ => &[
+            |v: Vec3| v.z >= 0.0 && v.x >= 0.0,
+            |v: Vec3| v.z >= 0.0 && v.x < 0.0,
+            |v: Vec3| v.z < 0.0 && v.x >= 0.0,
+            |v: Vec3| v.z < 0.0 && v.x < 0.0,
+        ],
+    };
+    regions
+        .iter()
+        .filter_map(|inside| {
+            mesh.vertices
+                .iter()
+                .copied()
+                .filter(|v| inside(*v))
+                .max_by(|a, b| a.y.total_cmp(&b.y))
+        })
+        .collect()
+}

@@ -1,0 +1,191 @@
+//! Reading tooth meshes: STL (binary or ASCII, `stl_io`), OBJ (`tobj`, polygons triangulated) and
+//! PLY (ASCII or binary, `ply-rs-bw`, polygons triangulated as fans). The result is an unchecked
+//! [`TriMesh`]; [`super::repair`] checks and repairs it.
+
+use std::{
+    fs::File,
+    io::{BufReader, Seek},
+    path::Path,
+};
+
+use glam::Vec3;
+
+use crate::geometry::TriMesh;
+
+/// Mesh file formats orthosim reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// STL, binary or ASCII.
+    Stl,
+    /// Wavefront OBJ.
+    Obj,
+    /// Stanford PLY, ASCII or binary.
+    Ply,
+}
+
+impl MeshFormat {
+    /// The format of a file, from its extension.
+    pub fn of(path: &Path) -> Result<Self, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("stl") => Ok(Self::Stl),
+            Some("obj") => Ok(Self::Obj),
+            Some("ply") => Ok(Self::Ply),
+            _ => Err("unknown mesh format: the file must end in .stl, .obj or .ply".into()),
+        }
+    }
+}
+
+/// Reads a mesh file (errors say what is wrong, on one line, without the path).
+pub fn read_mesh(path: &Path) -> Result<TriMesh, String> {
+    let format = MeshFormat::of(path)?;
+    let file = File::open(path).map_err(|e| format!("cannot read the mesh file: {e}"))?;
+    let mut reader = BufReader::new(file);
+    match format {
+        MeshFormat::Stl => read_stl(&mut reader),
+        MeshFormat::Obj => read_obj(&mut reader),
+        MeshFormat::Ply => read_ply(&mut reader),
+    }
+    .map_err(|e| one_line(&e))
+}
+
+/// Parsers' messages can span lines; errors are one line.
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, String> {
+    let len = reader
+        .seek(std::io::SeekFrom::End(0))
+        .map_err(|e| e.to_string())?;
+    reader.rewind().map_err(|e| e.to_string())?;
+    if len == 0 {
+        return Err("the file is empty".into());
+    }
+    let mesh = stl_io::read_stl(reader).map_err(|e| format!("not a valid STL file: {e}"))?;
+    Ok(TriMesh::new(
+        mesh.vertices
+            .iter()
+            .map(|v| Vec3::from_array(v.0))
+            .collect(),
+        mesh.faces
+            .iter()
+            .map(|f| f.vertices.map(|i| i as u32))
+            .collect(),
+    ))
+}
+
+fn read_obj<R: std::io::BufRead>(reader: &mut R) -> Result<TriMesh, String> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..Default::default()
+    };
+    // Materials are not needed: never open .mtl files.
+    let (models, _) =
+        tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| format!("not a valid OBJ file: {e}"))?;
+    let mut mesh = TriMesh::default();
+    for model in models {
+        let base = mesh.vertices.len() as u32;
+        let m = &model.mesh;
+        mesh.vertices.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        for t in m.indices.chunks_exact(3) {
+            mesh.triangles.push([t[0] + base, t[1] + base, t[2] + base]);
+        }
+    }
+    Ok(mesh)
+}
+
+fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, String> {
+    use ply_rs_bw::{parser::Parser, ply::DefaultElement, ply::Property};
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(reader)
+        .map_err(|e| format!("not a valid PLY file: {e}"))?;
+    let scalar = |p: &Property| -> Option<f64> {
+        Some(match *p {
+            Property::Char(v) => v as f64,
+            Property::UChar(v) => v as f64,
+            Property::Short(v) => v as f64,
+            Property::UShort(v) => v as f64,
+            Property::Int(v) => v as f64,
+            Property::UInt(v) => v as f64,
+            Property::Float(v) => v as f64,
+            Property::Double(v) => v,
+            _ => return None,
+        })
+    };
+    let list = |p: &Property| -> Option<Vec<i64>> {
+        Some(match p {
+            Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUChar(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListShort(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUShort(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListInt(v) => v.iter().map(|&x| x as i64).collect(),
+            Property::ListUInt(v) => v.iter().map(|&x| x as i64).collect(),
+            _ => return None,
+        })
+    };
+    let vertices = ply
+        .payload
+        .get("vertex")
+        .ok_or("the PLY file has no `vertex` element")?;
+    let mut mesh = TriMesh::default();
+    for (i, v) in vertices.iter().enumerate() {
+        let mut xyz = [0.0f32; 3];
+        for (k, name) in ["x", "y", "z"].iter().enumerate() {
+            let value = v
+                .get(*name)
+                .and_then(scalar)
+                .ok_or_else(|| format!("PLY vertex {i} has no numeric `{name}`"))?;
+            xyz[k] = value as f32;
+        }
+        mesh.vertices.push(Vec3::from_array(xyz));
+    }
+    let faces = ply
+        .payload
+        .get("face")
+        .ok_or("the PLY file has no `face` element")?;
+    for (i, f) in faces.iter().enumerate() {
+        let indices = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .and_then(list)
+            .ok_or_else(|| format!("PLY face {i} has no `vertex_indices` list"))?;
+        if indices.len() < 3 {
+            return Err(format!("PLY face {i} has {} vertices", indices.len()));
+        }
+        let index =
+            |x: i64| u32::try_from(x).map_err(|_| format!("PLY face {i} has the vertex index {x}"));
+        for k in 1..indices.len() - 1 {
+            mesh.triangles.push([
+                index(indices[0])?,
+                index(indices[k])?,
+                index(indices[k + 1])?,
+            ]);
+        }
+    }
+    Ok(mesh)
+}
+
+/// Writes a mesh as binary STL (facet normals from the triangles).
+pub fn write_stl(mesh: &TriMesh, out: &mut impl std::io::Write) -> std::io::Result<()> {
+    let triangles: Vec<stl_io::Triangle> = (0..mesh.triangles.len())
+        .map(|i| {
+            let [a, b, c] = mesh.triangle(i);
+            let n = (b - a).cross(c - a).normalize_or_zero();
+            stl_io::Triangle {
+                normal: stl_io::Normal::new(n.to_array()),
+                vertices: [a, b, c].map(|v| stl_io::Vertex::new(v.to_array())),
+            }
+        })
+        .collect();
+    stl_io::write_stl(out, triangles.iter())
+}

@@ -1,0 +1,493 @@
+//! Checking and repairing imported tooth meshes.
+//!
+//! In order: refuse empty meshes, non-finite coordinates and bad indices; weld vertices closer
+//! than [`RepairLimits::weld_mm`]; drop degenerate triangles (a repeated vertex, or an area below
+//! 10⁻¹² of the squared mesh size) and duplicated triangles; refuse edges shared by more than two
+//! triangles; keep the largest connected piece when the others are debris (each under
+//! [`RepairLimits::debris_fraction`] of the triangles), refuse several pieces otherwise; make the
+//! winding consistent (flipping triangles to agree with their neighbours, refusing non-orientable
+//! surfaces); close holes whose boundary is at most [`RepairLimits::max_hole_mm`] long with a fan
+//! from the boundary's centroid; then either refuse a larger opening or, when allowed, treat the
+//! single large opening as the cervical margin of a scanned crown, closed by a generated root (see
+//! [`super::root`]); turn the surface outward (positive volume); and finally check the result is a
+//! closed, manifold surface that does not intersect itself ([`TriMesh::validate_solid`]).
+
+use std::collections::{HashMap, HashSet, VecDeque};
+
+use glam::{DVec3, IVec3, Vec3};
+use serde::Serialize;
+
+use crate::geometry::TriMesh;
+
+/// Limits of what is repaired rather than refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RepairLimits {
+    /// Vertices closer than this are one vertex (mm).
+    pub weld_mm: f32,
+    /// Holes whose boundary is at most this long are closed (mm).
+    pub max_hole_mm: f32,
+    /// Pieces with fewer than this fraction of the triangles are dropped as debris.
+    pub debris_fraction: f32,
+}
+
+impl Default for RepairLimits {
+    fn default() -> Self {
+        Self {
+            weld_mm: 1e-5,
+            max_hole_mm: 6.0,
+            debris_fraction: 0.05,
+        }
+    }
+}
+
+/// What the repair did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Repairs {
+    /// Vertices merged into others.
+    pub welded_vertices: usize,
+    /// Degenerate triangles dropped.
+    pub degenerate_triangles: usize,
+    /// Duplicated triangles dropped.
+    pub duplicate_triangles: usize,
+    /// Small separate pieces dropped (and their triangles).
+    pub debris_pieces: usize,
+    /// Triangles flipped to agree with their neighbours.
+    pub flipped_triangles: usize,
+    /// The whole surface faced inward and was turned.
+    pub turned_outward: bool,
+    /// Boundary length (mm) of each hole closed.
+    pub holes_closed_mm: Vec<f32>,
+    /// Length (mm) of the cervical margin closed by a generated root, if one was generated.
+    pub root_generated_margin_mm: Option<f32>,
+}
+
+impl Repairs {
+    /// True when nothing had to be repaired.
+    pub fn is_clean(&self) -> bool {
+        *self == Repairs::default()
+    }
+
+    /// One line saying what was repaired ("nothing" when clean).
+    pub fn summary(&self) -> String {
+        let mut parts = Vec::new();
+        let mut say = |n: usize, what: &str| {
+            if n > 0 {
+                parts.push(format!("{n} {what}"));
+            }
+        };
+        say(self.welded_vertices, "duplicate vertices welded");
+        say(self.degenerate_triangles, "degenerate triangles dropped");
+        say(self.duplicate_triangles, "duplicated triangles dropped");
+        say(self.debris_pieces, "loose pieces dropped");
+        say(
+            self.flipped_triangles,
+            "triangles flipped to a consistent winding",
+        );
+        if !self.holes_closed_mm.is_empty() {
+            let lengths: Vec<String> = self
+                .holes_closed_mm
+                .iter()
+                .map(|l| format!("{l:.2}"))
+                .collect();
+            parts.push(format!(
+                "{} holes closed (boundaries {} mm)",
+                self.holes_closed_mm.len(),
+                lengths.join(", ")
+            ));
+        }
+        if self.turned_outward {
+            parts.push("surface turned outward".into());
+        }
+        if let Some(l) = self.root_generated_margin_mm {
+            parts.push(format!("root generated below a {l:.1} mm cervical margin"));
+        }
+        if parts.is_empty() {
+            "nothing".into()
+        } else {
+            parts.join("; ")
+        }
+    }
+}
+
+/// A surface with boundary loops still open after small holes were closed.
+#[derive(Clone, Debug)]
+pub(super) struct OpenSurface {
+    pub mesh: TriMesh,
+    /// Each remaining boundary loop: vertex indices in the direction the loop's edges run in their
+    /// triangles.
+    pub loops: Vec<Vec<u32>>,
+}
+
+fn near(v: Vec3) -> String {
+    format!("near ({:.3}, {:.3}, {:.3}) mm", v.x, v.y, v.z)
+}
+
+/// Checks, welds, cleans, orients and closes small holes. Large openings are returned as loops.
+pub(super) fn clean(
+    mesh: &TriMesh,
+    limits: &RepairLimits,
+    repairs: &mut Repairs,
+) -> Result<OpenSurface, String> {
+    if mesh.vertices.is_empty() || mesh.triangles.is_empty() {
+        return Err(format!(
+            "the mesh is empty ({} vertices, {} triangles)",
+            mesh.vertices.len(),
+            mesh.triangles.len()
+        ));
+    }
+    if let Some(i) = mesh.vertices.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "vertex {i} has a non-finite coordinate (NaN or infinity)"
+        ));
+    }
+    let n = mesh.vertices.len();
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+            return Err(format!(
+                "triangle {i} refers to vertex {v}, but there are only {n} vertices"
+            ));
+        }
+    }
+    let (vertices, triangles) = weld(mesh, limits.weld_mm, repairs);
+    let triangles = drop_degenerate(&vertices, triangles, repairs);
+    let triangles = keep_main_piece(&vertices, triangles, limits, repairs)?;
+    let triangles = orient(&vertices, triangles, repairs)?;
+    let mut mesh = TriMesh::new(vertices, triangles);
+    let loops = boundary_loops(&mesh)?;
+    let mut open = Vec::new();
+    for l in loops {
+        let length = loop_length(&mesh, &l);
+        if length <= limits.max_hole_mm {
+            fill_hole(&mut mesh, &l);
+            repairs.holes_closed_mm.push(length);
+        } else {
+            open.push(l);
+        }
+    }
+    Ok(OpenSurface { mesh, loops: open })
+}
+
+/// Merges vertices within `tol` of each other (first come keeps its position) and drops the
+/// vertices no triangle uses.
+fn weld(mesh: &TriMesh, tol: f32, repairs: &mut Repairs) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let cell = tol.max(1e-9);
+    let key = |v: Vec3| (v / cell).floor().as_ivec3();
+    let mut grid: HashMap<IVec3, Vec<u32>> = HashMap::new();
+    let mut vertices: Vec<Vec3> = Vec::new();
+    let mut map = vec![u32::MAX; mesh.vertices.len()];
+    let mut used = vec![false; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    for (i, &v) in mesh.vertices.iter().enumerate() {
+        if !used[i] {
+            continue;
+        }
+        let k = key(v);
+        let mut found = None;
+        'search: for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(list) = grid.get(&(k + IVec3::new(dx, dy, dz))) {
+                        for &j in list {
+                            if vertices[j as usize].distance(v) <= tol {
+                                found = Some(j);
+                                break 'search;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        map[i] = match found {
+            Some(j) => {
+                repairs.welded_vertices += 1;
+                j
+            }
+            None => {
+                let j = vertices.len() as u32;
+                vertices.push(v);
+                grid.entry(k).or_default().push(j);
+                j
+            }
+        };
+    }
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| map[v as usize]))
+        .collect();
+    (vertices, triangles)
+}
+
+fn drop_degenerate(
+    vertices: &[Vec3],
+    triangles: Vec<[u32; 3]>,
+    repairs: &mut Repairs,
+) -> Vec<[u32; 3]> {
+    let (lo, hi) = vertices.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &v| (lo.min(v), hi.max(v)),
+    );
+    let scale = (hi - lo).max_element().max(f32::MIN_POSITIVE) as f64;
+    let mut seen = HashSet::new();
+    let mut kept = Vec::with_capacity(triangles.len());
+    for t in triangles {
+        let [a, b, c] = t.map(|i| vertices[i as usize].as_dvec3());
+        let area = 0.5 * (b - a).cross(c - a).length();
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || area <= 1e-12 * scale * scale {
+            repairs.degenerate_triangles += 1;
+            continue;
+        }
+        let mut sorted = t;
+        sorted.sort_unstable();
+        if !seen.insert(sorted) {
+            repairs.duplicate_triangles += 1;
+            continue;
+        }
+        kept.push(t);
+    }
+    kept
+}
+
+fn undirected(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// Triangles around each undirected edge; refuses edges with more than two.
+fn edge_map(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> Result<HashMap<(u32, u32), Vec<usize>>, String> {
+    let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::with_capacity(triangles.len() * 2);
+    for (i, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            edges
+                .entry(undirected(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(i);
+        }
+    }
+    let mut bad: Vec<_> = edges.iter().filter(|(_, l)| l.len() > 2).collect();
+    bad.sort_unstable_by_key(|(e, _)| **e);
+    if let Some(((a, b), list)) = bad.first() {
+        let mid = (vertices[*a as usize] + vertices[*b as usize]) / 2.0;
+        return Err(format!(
+            "the mesh is non-manifold: an edge {} is shared by {} triangles ({} such edges)",
+            near(mid),
+            list.len(),
+            bad.len()
+        ));
+    }
+    Ok(edges)
+}
+
+fn keep_main_piece(
+    vertices: &[Vec3],
+    triangles: Vec<[u32; 3]>,
+    limits: &RepairLimits,
+    repairs: &mut Repairs,
+) -> Result<Vec<[u32; 3]>, String> {
+    if triangles.is_empty() {
+        return Err("the mesh has no triangle of non-zero area".into());
+    }
+    let edges = edge_map(vertices, &triangles)?;
+    let mut piece = vec![usize::MAX; triangles.len()];
+    let mut sizes = Vec::new();
+    for start in 0..triangles.len() {
+        if piece[start] != usize::MAX {
+            continue;
+        }
+        let id = sizes.len();
+        let mut size = 0;
+        let mut queue = VecDeque::from([start]);
+        piece[start] = id;
+        while let Some(i) = queue.pop_front() {
+            size += 1;
+            let t = triangles[i];
+            for k in 0..3 {
+                for &j in &edges[&undirected(t[k], t[(k + 1) % 3])] {
+                    if piece[j] == usize::MAX {
+                        piece[j] = id;
+                        queue.push_back(j);
+                    }
+                }
+            }
+        }
+        sizes.push(size);
+    }
+    if sizes.len() == 1 {
+        return Ok(triangles);
+    }
+    let main = (0..sizes.len()).max_by_key(|&i| sizes[i]).unwrap_or(0);
+    let limit = (limits.debris_fraction * triangles.len() as f32).ceil() as usize;
+    let big: Vec<usize> = (0..sizes.len())
+        .filter(|&i| i != main && sizes[i] >= limit)
+        .collect();
+    if !big.is_empty() {
+        return Err(format!(
+            "the file holds {} separate pieces of {} triangles or more: one tooth per file",
+            big.len() + 1,
+            limit
+        ));
+    }
+    repairs.debris_pieces += sizes.len() - 1;
+    Ok(triangles
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| piece[*i] == main)
+        .map(|(_, t)| t)
+        .collect())
+}
+
+/// Makes neighbouring triangles run their shared edges in opposite directions, flipping the fewer.
+fn orient(
+    vertices: &[Vec3],
+    mut triangles: Vec<[u32; 3]>,
+    repairs: &mut Repairs,
+) -> Result<Vec<[u32; 3]>, String> {
+    let edges = edge_map(vertices, &triangles)?;
+    let runs = |t: &[u32; 3], a: u32, b: u32| (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b);
+    let mut flip = vec![None::<bool>; triangles.len()];
+    flip[0] = Some(false);
+    let mut queue = VecDeque::from([0usize]);
+    while let Some(i) = queue.pop_front() {
+        let fi = flip[i].unwrap_or(false);
+        let mut t = triangles[i];
+        if fi {
+            t.swap(1, 2);
+        }
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            for &j in &edges[&undirected(a, b)] {
+                if j == i {
+                    continue;
+                }
+                // j must run b→a; it runs a→b as stored if it needs flipping.
+                let want = runs(&triangles[j], a, b);
+                match flip[j] {
+                    None => {
+                        flip[j] = Some(want);
+                        queue.push_back(j);
+                    }
+                    Some(f) if f != want => {
+                        let mid = (vertices[a as usize] + vertices[b as usize]) / 2.0;
+                        return Err(format!(
+                            "the surface cannot be oriented (a Möbius-like twist) at the edge {}",
+                            near(mid)
+                        ));
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    let flips = flip.iter().filter(|f| **f == Some(true)).count();
+    // Keep the orientation of the majority; the outward check comes once the surface is closed.
+    let invert_all = flips * 2 > triangles.len();
+    for (t, f) in triangles.iter_mut().zip(&flip) {
+        if f.unwrap_or(false) != invert_all {
+            t.swap(1, 2);
+        }
+    }
+    repairs.flipped_triangles += if invert_all {
+        triangles.len() - flips
+    } else {
+        flips
+    };
+    Ok(triangles)
+}
+
+/// Boundary loops of a consistently wound surface, each in its edges' direction.
+fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, String> {
+    let mut directed = HashSet::with_capacity(mesh.triangles.len() * 3);
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            directed.insert((t[k], t[(k + 1) % 3]));
+        }
+    }
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    let mut boundary: Vec<(u32, u32)> = directed
+        .iter()
+        .filter(|(a, b)| !directed.contains(&(*b, *a)))
+        .copied()
+        .collect();
+    boundary.sort_unstable();
+    for &(a, b) in &boundary {
+        if next.insert(a, b).is_some() {
+            return Err(format!(
+                "the mesh is non-manifold: two holes meet at the vertex {}",
+                near(mesh.vertices[a as usize])
+            ));
+        }
+    }
+    let mut loops = Vec::new();
+    let mut done = HashSet::new();
+    for &(start, _) in &boundary {
+        if done.contains(&start) {
+            continue;
+        }
+        let mut l = vec![start];
+        done.insert(start);
+        let mut cur = next[&start];
+        while cur != start {
+            if !done.insert(cur) {
+                return Err(format!(
+                    "the mesh is non-manifold at the vertex {}",
+                    near(mesh.vertices[cur as usize])
+                ));
+            }
+            l.push(cur);
+            cur = *next.get(&cur).ok_or_else(|| {
+                format!(
+                    "a hole's boundary does not close at the vertex {}",
+                    near(mesh.vertices[cur as usize])
+                )
+            })?;
+        }
+        loops.push(l);
+    }
+    Ok(loops)
+}
+
+pub(super) fn loop_length(mesh: &TriMesh, l: &[u32]) -> f32 {
+    (0..l.len())
+        .map(|i| {
+            mesh.vertices[l[i] as usize].distance(mesh.vertices[l[(i + 1) % l.len()] as usize])
+        })
+        .sum()
+}
+
+/// Length-weighted centroid of a loop.
+pub(super) fn loop_centroid(mesh: &TriMesh, l: &[u32]) -> Vec3 {
+    let mut sum = DVec3::ZERO;
+    let mut total = 0.0;
+    for i in 0..l.len() {
+        let a = mesh.vertices[l[i] as usize].as_dvec3();
+        let b = mesh.vertices[l[(i + 1) % l.len()] as usize].as_dvec3();
+        let w = a.distance(b);
+        sum += (a + b) * 0.5 * w;
+        total += w;
+    }
+    if total > 0.0 {
+        (sum / total).as_vec3()
+    } else {
+        mesh.vertices[l[0] as usize]
+    }
+}
+
+/// Closes a hole with a fan from its centroid, wound to match the surrounding triangles.
+fn fill_hole(mesh: &mut TriMesh, l: &[u32]) {
+    if l.len() == 3 {
+        mesh.triangles.push([l[2], l[1], l[0]]);
+        return;
+    }
+    let c = mesh.vertices.len() as u32;
+    mesh.vertices.push(loop_centroid(mesh, l));
+    for i in 0..l.len() {
+        let (a, b) = (l[i], l[(i + 1) % l.len()]);
+        mesh.triangles.push([b, a, c]);
+    }
+}
