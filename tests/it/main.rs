@@ -3,10 +3,12 @@
 mod cli;
 mod collision;
 mod ecs;
+mod fuzz;
 mod geometry_props;
 mod import;
 mod movement;
 mod oracle;
 mod parry_support;
+mod stress;
 mod teeth;
 mod window;

@@ -11,9 +11,11 @@
 //! 2. **First time (Eq. 2)**, for every node pair that passes, inner or leaf:
 //!    t = (|A|² − R²) / (−A·B + √((A·B)² − |B|²(|A|² − R²))), the conjugate form of the paper's
 //!    root, which has no cancellation; overlap at t = 0 gives 0; |B|² = 0, A·B ≥ 0 or a negative
-//!    discriminant give no contact (the spheres are apart at t = 0 and never approach). The time is
-//!    rounded down by a relative 10⁻¹², and R carries a slack above the rounding of the transformed
-//!    centres, so it is never after the true one.
+//!    discriminant give no contact (the spheres are apart at t = 0 and never approach). Every
+//!    coefficient is bracketed by a forward error bound and the root taken from the bounds that
+//!    make it smallest, so for the given A, B and R the time is never after the true one (see
+//!    [`first_contact`]); R carries a slack above the rounding of the transformed centres, so the
+//!    same holds for the real motion.
 //!
 //! A node pair's time bounds its descendants' from below, so the search visits pairs earliest first
 //! and, for the continuous method, skips pairs that cannot beat the earliest leaf time found. The
@@ -71,26 +73,52 @@ pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
     m - 1e-12 * (a.length_squared() + bb) - 1e-300 <= rr
 }
 
+/// What the contact distance is widened by when sphere centres are computed (in f64) from
+/// coordinates up to `scale` mm: far above the rounding of the relative centres A and B.
+pub fn rounding_slack(scale: f64) -> f64 {
+    1e-13 * scale + 1e-9
+}
+
 /// First time in [0, 1) at which spheres with relative centre A + B·t come within `r`, rounded
 /// down; None if they do not during the step.
+///
+/// Guarantee, for finite inputs below 10¹⁵⁰: if |A + B·t| ≤ r for some t in [0, 1), the result is
+/// Some(t') with t' ≤ the first such t (exactly, not only up to rounding). Each coefficient —
+/// c = |A|² − r², A·B, |B|² and the discriminant (A·B)² − |B|²·c — is computed in f64 with a
+/// forward error bound (8 unit roundoffs of the sum of the magnitudes it adds, well above the
+/// γ₃ of a three-term dot product, plus a little for underflow), which brackets the true value;
+/// the root c / (−A·B + √disc), which grows with c and shrinks with −A·B and disc, is evaluated
+/// from the bounds that make it smallest and rounded down. A result may be a little early, or
+/// Some when the spheres pass within a few ulps of touching (conservative).
 #[inline]
 pub fn first_contact(a: DVec3, b: DVec3, r: f64) -> Option<f64> {
-    let c = a.length_squared() - r * r;
-    if c <= 0.0 {
+    // 8 unit roundoffs, and an absolute term far above the error of an underflowing product.
+    const K: f64 = 8.0 * f64::EPSILON / 2.0;
+    const TINY: f64 = 8.0 * f64::MIN_POSITIVE;
+    let aa = a.length_squared();
+    let rr = r * r;
+    let c_lo = (aa - rr) - (K * (aa + rr) + TINY);
+    if c_lo <= 0.0 {
         return Some(0.0);
     }
     let ab = a.dot(b);
-    let bb = b.length_squared();
-    if ab >= 0.0 || bb <= 0.0 {
+    let e_ab = K * ((a.x * b.x).abs() + (a.y * b.y).abs() + (a.z * b.z).abs()) + TINY;
+    let ab_lo = ab - e_ab;
+    if ab_lo >= 0.0 {
+        // Not approaching: |A + B·t|² ≥ c > 0 for all t ≥ 0.
         return None;
     }
-    let disc = ab * ab - bb * c;
-    if disc < 0.0 {
+    let ab_max = (-ab_lo).max((ab + e_ab).abs());
+    let bb_lo = (b.length_squared() * (1.0 - K) - TINY).max(0.0);
+    let square = ab_max * ab_max;
+    let product = bb_lo * c_lo;
+    let disc_hi = (square - product) + (K * (square + product) + TINY);
+    if disc_hi < 0.0 {
         return None;
     }
-    let t = c / (-ab + disc.sqrt());
-    let t = (t * (1.0 - 1e-12) - 1e-15).max(0.0);
-    (t < 1.0).then_some(t)
+    let denominator = ((-ab_lo) + disc_hi.sqrt()) * (1.0 + K);
+    let t = (c_lo / denominator) * (1.0 - K);
+    (t < 1.0).then_some(t.max(0.0))
 }
 
 /// Calls `leaf(i, j, t)` for every leaf pair whose swept (inflated) spheres meet during the step;
@@ -120,7 +148,7 @@ pub fn swept_leaves(
         + a.shape.max_rho as f64
         + b.shape.max_rho as f64
         + 100.0;
-    let slack = 1e-13 * scale + 1e-9;
+    let slack = rounding_slack(scale);
     CACHE.with_borrow_mut(|(cache_a, cache_b)| {
         cache_a.begin(ta.spheres.len());
         cache_b.begin(tb.spheres.len());
@@ -299,8 +327,12 @@ mod tests {
             1.0,
         )
         .unwrap();
-        // (|A|² − R² loses digits here; the slack callers add to R covers it.)
         assert!((0.0..=1e-6 * (1.0 + 1e-6)).contains(&t), "{t}");
+        // Touching exactly at the start while moving apart is a contact at t = 0.
+        assert_eq!(
+            first_contact(DVec3::new(3.0, 4.0, 0.0), DVec3::new(3.0, 4.0, 0.0), 5.0),
+            Some(0.0)
+        );
         // Contact only after the step.
         assert_eq!(
             first_contact(DVec3::new(5.0, 0.0, 0.0), DVec3::new(-1.0, 0.0, 0.0), 2.0),
