@@ -298,17 +298,23 @@ fn apply_loads(
         group_messages.clear();
         return;
     };
+    let mut refuse = |e: String| {
+        warn!("{e}");
+        state.notice = Some(e);
+    };
     for m in group_messages.read() {
-        let finite = m.load.force.is_finite() && m.load.torque.is_finite();
-        match sim.groups.get_mut(m.group) {
-            Some(g) if finite => g.load = m.load,
-            Some(_) => warn!("ignored a group load with non-finite components"),
-            None => warn!("ignored a load for group {}: no such group", m.group),
+        match (sim.groups.get_mut(m.group), m.load.check()) {
+            (Some(g), Ok(())) => g.load = m.load,
+            (Some(_), Err(e)) => refuse(e),
+            (None, _) => refuse(format!(
+                "a load for group {} was refused: no such group",
+                m.group
+            )),
         }
     }
     for m in messages.read() {
-        if !(m.load.force.is_finite() && m.load.torque.is_finite()) {
-            warn!("ignored a load with non-finite components");
+        if let Err(e) = m.load.check() {
+            refuse(e);
             continue;
         }
         if let Ok((_, mut l)) = loads.get_mut(m.tooth) {
@@ -319,12 +325,10 @@ fn apply_loads(
         if !load.is_changed() {
             continue;
         }
-        if !(load.force.is_finite() && load.torque.is_finite()) {
-            warn!("ignored a load with non-finite components");
-            continue;
-        }
-        if let Some(i) = state.entities.iter().position(|x| *x == e) {
-            sim.set_load(i, *load);
+        if let Some(i) = state.entities.iter().position(|x| *x == e)
+            && let Err(e) = sim.set_load(i, *load)
+        {
+            refuse(e);
         }
     }
 }

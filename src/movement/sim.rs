@@ -344,9 +344,12 @@ impl Simulation {
         self.teeth.iter().position(|t| t.fdi == fdi)
     }
 
-    /// Replaces a tooth's own load (for the UI and messages).
-    pub fn set_load(&mut self, i: usize, load: Load) {
+    /// Replaces a tooth's own load (for the UI and messages); refuses, keeping the old one, a load
+    /// that [`Load::check`] refuses.
+    pub fn set_load(&mut self, i: usize, load: Load) -> Result<(), String> {
+        load.check()?;
         self.teeth[i].load = load;
+        Ok(())
     }
 
     /// Replaces a tooth's archwire model.
