@@ -467,3 +467,106 @@ fn report_writes_every_file_its_page_refers_to() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
+    let dir = std::env::temp_dir().join(format!("orthosim-cli-export-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = orthosim(&[
+        "export-case",
+        "--case",
+        "case1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let case = dir.join("case1.ron");
+    assert!(case.exists());
+    assert_eq!(
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| e
+                .as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "stl"))
+            .count(),
+        32
+    );
+    let inspect = |case: &str| {
+        let out = orthosim(&["inspect", "--case", case, "--json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (a, b) = (inspect("case1"), inspect(case.to_str().unwrap()));
+    assert_eq!(b["imported"].as_array().unwrap().len(), 32);
+    for m in b["imported"].as_array().unwrap() {
+        assert_eq!(m["summary"], "nothing", "{m}");
+    }
+    let gaps = |v: &serde_json::Value| -> Vec<f64> {
+        v["neighbour_gaps_mm"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|g| g["gap_mm"].as_f64().unwrap())
+            .collect()
+    };
+    let (ga, gb) = (gaps(&a), gaps(&b));
+    assert_eq!(ga.len(), gb.len());
+    for (x, y) in ga.iter().zip(&gb) {
+        assert!((x - y).abs() < 1e-3, "{x} vs {y}");
+    }
+    // The imported case simulates like the original: the same teeth move, about as far.
+    let simulate = |case: &str| {
+        let out = orthosim(&[
+            "simulate",
+            "--case",
+            case,
+            "--tree",
+            "octree",
+            "--no-cache",
+            "--max-steps",
+            "300",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (sa, sb) = (simulate("case1"), simulate(case.to_str().unwrap()));
+    assert_eq!(sa["moved"], sb["moved"]);
+    assert!(!sa["moved"].as_array().unwrap().is_empty());
+    for (fdi, da) in sa["displacement_mm"].as_object().unwrap() {
+        let (da, db) = (
+            da.as_f64().unwrap(),
+            sb["displacement_mm"][fdi].as_f64().unwrap(),
+        );
+        assert!((da - db).abs() <= 0.05 + 0.1 * da, "{fdi}: {da} vs {db} mm");
+    }
+    assert!(sb["max_penetration_mm"].as_f64().unwrap() < 0.05, "{sb}");
+    // Exporting over the folder the case was read from is refused, and nothing is lost.
+    let before = std::fs::read(&case).unwrap();
+    let again = orthosim(&[
+        "export-case",
+        "--case",
+        case.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("refusing"));
+    assert_eq!(std::fs::read(&case).unwrap(), before);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -317,6 +317,8 @@ fn broken_meshes_are_refused_with_the_reason() {
         assert!(e.contains(what), "expected '{what}' in: {e}");
     };
     refuse(&TriMesh::default(), "empty");
+    // A file in metres read as millimetres.
+    refuse(&mesh.map_vertices(|v| v / 1000.0), "units");
     let mut m = mesh.clone();
     m.vertices[3].x = f32::NAN;
     refuse(&m, "non-finite");
@@ -382,7 +384,9 @@ fn bad_mesh_files_fail_naming_the_file_and_tooth() {
         b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\nbanana\n",
     )
     .unwrap();
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n").unwrap();
     for (file, what) in [
+        ("bad.obj", "line 3"),
         ("empty.stl", "empty"),
         ("nan.obj", "non-finite"),
         ("junk.ply", "PLY"),

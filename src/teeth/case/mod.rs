@@ -190,7 +190,9 @@ impl Case {
         if source.trim().is_empty() {
             return Err(invalid(1, 1, "case file is empty".into()));
         }
+        // `resolution: 125` and `resolution: Some(125)` both read as Some(125).
         let case: Case = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(source)
             .map_err(|e| invalid(e.span.start.line, e.span.start.col, e.code.to_string()))?;
         case.check().map_err(|(field, token, message)| {
@@ -423,6 +425,18 @@ fn locate(source: &str, field: &str, token: Option<&str>) -> (usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn optional_numbers_read_with_or_without_some() {
+        for src in [
+            r#"Case(name: "x", resolution: 300, constraints: [(teeth: [11], max_translation_mm: 2.0)])"#,
+            r#"Case(name: "x", resolution: Some(300), constraints: [(teeth: [11], max_translation_mm: Some(2.0))])"#,
+        ] {
+            let c = Case::parse(src, "t.ron").unwrap().case;
+            assert_eq!(c.resolution, Some(300), "{src}");
+            assert_eq!(c.constraints[0].max_translation_mm.map(|v| v.0), Some(2.0));
+        }
+    }
 
     fn err(src: &str) -> (usize, usize, String) {
         match Case::parse(src, "t.ron") {

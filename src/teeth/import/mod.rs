@@ -107,6 +107,11 @@ pub struct ToothMeshFile {
     pub transform: MeshTransform,
 }
 
+/// The least extent of a tooth mesh (mm): smaller ones are refused (wrong units, or not a tooth).
+pub const MIN_SPAN_MM: f32 = 2.0;
+/// The largest extent of a tooth mesh (mm).
+pub const MAX_SPAN_MM: f32 = 80.0;
+
 /// A single large opening is taken for a crown's cervical margin (and closed by a generated root)
 /// only when the direction away from the crown through it is within 60° of the arch's apical
 /// direction.
@@ -148,6 +153,16 @@ pub fn import_mesh(
     limits: &RepairLimits,
 ) -> Result<ImportedTooth, String> {
     let an = anatomy(fdi.arch(), fdi.kind());
+    // (Non-finite coordinates are refused by the repair, naming the vertex.)
+    if !world.vertices.is_empty() && world.vertices.iter().all(|v| v.is_finite()) {
+        let span = world.aabb().extent().max_element();
+        if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
+            return Err(format!(
+                "the mesh spans {span:.4} mm, not a tooth's {MIN_SPAN_MM}–{MAX_SPAN_MM} mm: are \
+                 its units right (units: Millimetres, Metres or Inches)?"
+            ));
+        }
+    }
     let mut repairs = Repairs::default();
     let open = repair::clean(world, limits, &mut repairs)?;
     let mut mesh = open.mesh;

@@ -46,7 +46,10 @@ pub fn read_mesh(path: &Path) -> Result<TriMesh, String> {
     let mut reader = BufReader::new(file);
     match format {
         MeshFormat::Stl => read_stl(&mut reader),
-        MeshFormat::Obj => read_obj(&mut reader),
+        MeshFormat::Obj => read_obj(&mut reader).map_err(|e| match obj_bad_line(path) {
+            Some(line) => format!("{e} (line {line})"),
+            None => e,
+        }),
         MeshFormat::Ply => read_ply(&mut reader),
     }
     .map_err(|e| one_line(&e))
@@ -65,7 +68,22 @@ fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, String> 
     if len == 0 {
         return Err("the file is empty".into());
     }
-    let mesh = stl_io::read_stl(reader).map_err(|e| format!("not a valid STL file: {e}"))?;
+    let mesh = stl_io::read_stl(reader).map_err(|e| {
+        // A binary file that ends early: say what its header promised.
+        let mut head = [0u8; 84];
+        let promised = (len >= 84
+            && reader.rewind().is_ok()
+            && std::io::Read::read_exact(reader, &mut head).is_ok())
+        .then(|| u32::from_le_bytes([head[80], head[81], head[82], head[83]]) as u64);
+        match promised {
+            Some(n) if 84 + 50 * n != len && !head.starts_with(b"solid") => format!(
+                "not a valid STL file: as binary STL its header announces {n} triangles \
+                 ({} bytes), but the file has {len} bytes",
+                84 + 50 * n
+            ),
+            _ => format!("not a valid STL file: {e}"),
+        }
+    })?;
     Ok(TriMesh::new(
         mesh.vertices
             .iter()
@@ -102,6 +120,32 @@ fn read_obj<R: std::io::BufRead>(reader: &mut R) -> Result<TriMesh, String> {
         }
     }
     Ok(mesh)
+}
+
+/// The first line of an OBJ file whose vertex or face record does not parse, for error messages.
+fn obj_bad_line(path: &Path) -> Option<usize> {
+    let text = std::fs::read(path).ok()?;
+    let text = String::from_utf8_lossy(&text);
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let ok = match words.next() {
+            Some("v") => {
+                let numbers: Vec<_> = words.map(str::parse::<f32>).collect();
+                numbers.len() >= 3 && numbers.iter().all(Result::is_ok)
+            }
+            Some("f") => {
+                let corners: Vec<_> = words
+                    .map(|w| w.split('/').next().unwrap_or("").parse::<i64>())
+                    .collect();
+                corners.len() >= 3 && corners.iter().all(|c| c.as_ref().is_ok_and(|&c| c != 0))
+            }
+            _ => true,
+        };
+        if !ok {
+            return Some(i + 1);
+        }
+    }
+    None
 }
 
 fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, String> {
