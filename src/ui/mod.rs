@@ -1,7 +1,8 @@
 //! The control panel (feature `viewer`, bevy_egui): case, simulation controls, collision settings
 //! and live readouts.
 //!
-//! - **Case**: load a built-in case, reset the current one.
+//! - **Case**: load a built-in case or a case file (the error shown if it fails), reset the
+//!   current one.
 //! - **Simulation**: play / pause, single step, speed (the virtual clock's rate, which drives the
 //!   fixed simulation step).
 //! - **Collision**: narrow-phase method and response apply at once; a new tree builder or depth
@@ -35,7 +36,7 @@ use crate::{
     },
     occlusion_view::{Roots, Selection},
     sphere_tree::{SphereTreeProgress, SphereTreeSettings, TreeMethod},
-    teeth::{ActiveCase, Case, LoadCase, Tooth},
+    teeth::{ActiveCase, Case, CaseLoadFailed, CaseLoaded, LoadCase, Tooth},
     teeth::{Extracted, Load, Wire, WireModel},
 };
 
@@ -80,6 +81,10 @@ struct PanelState {
     gaps_timer: f32,
     /// Smoothed frame time (s).
     frame: f32,
+    /// Case file path typed in the panel.
+    file: String,
+    /// The last case that failed to load, and why.
+    load_error: Option<String>,
 }
 
 impl Default for PanelState {
@@ -93,6 +98,8 @@ impl Default for PanelState {
             gaps_at_step: None,
             gaps_timer: 0.0,
             frame: 1.0 / 60.0,
+            file: String::new(),
+            load_error: None,
         }
     }
 }
@@ -341,7 +348,14 @@ fn panel(
     mut load: MessageWriter<LoadCase>,
     mut overlays: ResMut<crate::occlusion_view::Overlays>,
     progress: Res<SphereTreeProgress>,
+    (mut failed, mut loaded): (MessageReader<CaseLoadFailed>, MessageReader<CaseLoaded>),
 ) -> Result {
+    if let Some(e) = failed.read().last() {
+        state.load_error = Some(e.0.to_string());
+    }
+    if loaded.read().last().is_some() {
+        state.load_error = None;
+    }
     let dt = real.delta_secs();
     if dt > 0.0 {
         state.frame = 0.9 * state.frame + 0.1 * dt;
@@ -370,10 +384,27 @@ fn panel(
                     load.write(LoadCase(name.clone()));
                 }
             });
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::TextEdit::singleline(&mut state.file)
+                        .hint_text("case file (.ron)")
+                        .desired_width(200.0),
+                );
+                let path = state.file.trim().to_owned();
+                if ui
+                    .add_enabled(!path.is_empty(), egui::Button::new("Load file"))
+                    .clicked()
+                {
+                    load.write(LoadCase(path));
+                }
+            });
             ui.label(format!(
                 "showing: {}",
                 current.as_deref().unwrap_or("(loading)")
             ));
+            if let Some(e) = &state.load_error {
+                ui.colored_label(egui::Color32::LIGHT_RED, e);
+            }
 
             ui.separator();
             ui.heading("Simulation");

@@ -16,7 +16,11 @@ use glam::DVec3;
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{Signed, Zero};
-use orthosim::collision::narrow_phase::continuous::{first_contact, rounding_slack};
+use orthosim::{
+    collision::narrow_phase::continuous::{first_contact, may_meet, rounding_slack},
+    geometry::interval::Interval,
+};
+use proptest::prelude::*;
 
 fn q(x: f64) -> BigRational {
     BigRational::from_float(x).expect("finite")
@@ -149,6 +153,7 @@ struct Tally {
     contacts: usize,
     false_negatives: usize,
     late: usize,
+    broad_misses: usize,
     false_positives: usize,
     far_false_positives: usize,
 }
@@ -160,6 +165,10 @@ fn check(tally: &mut Tally, seen: (DVec3, DVec3, f64), exact: &Exact) {
     let got = first_contact(seen.0, seen.1, seen.2);
     if exact.contact() {
         tally.contacts += 1;
+        // The broad phase's test must let every contact through.
+        if !may_meet(seen.0, seen.1, seen.2) {
+            tally.broad_misses += 1;
+        }
         match got {
             None => tally.false_negatives += 1,
             Some(t) if !exact.not_after_first(t) => tally.late += 1,
@@ -258,6 +267,7 @@ fn run(n: usize, seed: u64) -> Tally {
 fn assert_sound(t: &Tally) {
     assert_eq!(t.false_negatives, 0, "{t:?}");
     assert_eq!(t.late, 0, "{t:?}");
+    assert_eq!(t.broad_misses, 0, "{t:?}");
     assert_eq!(t.far_false_positives, 0, "{t:?}");
     // The suite exercises both outcomes.
     assert!(
@@ -280,4 +290,38 @@ fn ten_million_sphere_pair_motions() {
     let t = run(1_250_000, 0xc0ffee);
     println!("{t:?}");
     assert_sound(&t);
+}
+
+/// f64 values across many magnitudes, both signs, zero and subnormals.
+fn wide() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        (-1e4f64..1e4),
+        (-300i32..300, -1.0f64..1.0).prop_map(|(e, m)| m * 2f64.powi(e)),
+        Just(0.0),
+        Just(f64::MIN_POSITIVE / 4.0),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Interval operations contain the exact (rational) result for members of their operands: the
+    /// outward rounding is checked against exact arithmetic, not against f64 results.
+    #[test]
+    fn interval_bounds_contain_the_exact_results(a in wide(), b in wide(), c in wide(), d in wide(),
+                                                 s in 0.0f64..=1.0, u in 0.0f64..=1.0) {
+        let (x, y) = (Interval::new(a, b), Interval::new(c, d));
+        // Members: the ends and a point between.
+        let pick = |i: Interval, f: f64| [i.lo, i.hi, (i.lo + (i.hi - i.lo) * f).clamp(i.lo, i.hi)];
+        for xv in pick(x, s) {
+            for yv in pick(y, u) {
+                let (qx, qy) = (q(xv), q(yv));
+                let inside = |i: Interval, v: BigRational| q(i.lo) <= v && v <= q(i.hi);
+                prop_assert!(inside(x.add(y), &qx + &qy));
+                prop_assert!(inside(x.sub(y), &qx - &qy));
+                prop_assert!(inside(x.mul(y), &qx * &qy));
+                prop_assert!(inside(x.sqr(), &qx * &qx));
+            }
+        }
+    }
 }
