@@ -597,6 +597,25 @@ fn list_cases() {
     }
 }
 
+/// Refuses to write `output` when it is one of the command's input files (the case file named by
+/// `case`, when it is a file): outputs never replace inputs.
+fn never_overwrite(output: &std::path::Path, case: &str) -> Result<()> {
+    let same = match (
+        std::fs::canonicalize(output),
+        std::fs::canonicalize(std::path::Path::new(case)),
+    ) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same {
+        anyhow::bail!(
+            "{}: refusing to overwrite the case file being read",
+            output.display()
+        );
+    }
+    Ok(())
+}
+
 fn run_export_case(case: &str, out: &std::path::Path) -> Result<()> {
     let d = Dentition::build(Case::resolve(case)?)?;
     let report = orthosim::teeth::import::export_case(&d, out).map_err(anyhow::Error::msg)?;
@@ -701,6 +720,7 @@ fn run_trees(
             .with_context(|| format!("{}: cannot create folder", dir.display()))?;
         for (fdi, tree) in &trees {
             let path = dir.join(format!("{fdi}.sph"));
+            never_overwrite(&path, case)?;
             write_atomic(&path, &tree.to_sph())
                 .with_context(|| format!("{}: cannot write", path.display()))?;
         }
@@ -801,6 +821,7 @@ fn screenshot(
     if out.extension().and_then(|e| e.to_str()) != Some("png") {
         anyhow::bail!("{}: the screenshot must be a .png file", out.display());
     }
+    never_overwrite(out, case)?;
     let shared = std::sync::Arc::new(std::sync::Mutex::new(ScreenshotOutcome::default()));
     let mut app = window_app(case, format!("orthosim: {case}"), tree);
     app.insert_resource(CollisionSettings { method: algorithm });

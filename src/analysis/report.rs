@@ -123,6 +123,29 @@ pub fn run_report(
     progress: &(dyn Fn(&str, usize, usize) + Sync),
 ) -> Result<Summary> {
     std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    // Outputs never replace inputs: refuse before any work if a file to be written is a case file
+    // being read.
+    let mut outputs: Vec<std::path::PathBuf> = ["summary.json", "distances.csv", "index.html"]
+        .iter()
+        .map(|n| out.join(n))
+        .collect();
+    let mut inputs = Vec::new();
+    for case in &opts.cases {
+        let loaded = Case::resolve(case)?;
+        outputs.push(out.join(format!("{}.svg", loaded.case.name)));
+        outputs.push(out.join(format!("{}.png", loaded.case.name)));
+        if let Ok(p) = std::fs::canonicalize(case) {
+            inputs.push(p);
+        }
+    }
+    for o in &outputs {
+        if std::fs::canonicalize(o).is_ok_and(|p| inputs.contains(&p)) {
+            anyhow::bail!(
+                "{}: refusing to overwrite a case file being read",
+                o.display()
+            );
+        }
+    }
     let total = opts.cases.len() * (Method::ALL.len() + 1) + 2 * opts.fit_depths.len();
     let mut done = 0;
     let mut cases = BTreeMap::new();

@@ -99,7 +99,16 @@ impl MovementSettings {
                 e.code
             )
         })?;
-        s.validate().map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        s.validate().map_err(|e| {
+            // Point at the offending field (the message names it).
+            let field = e.split_whitespace().nth(2).unwrap_or("");
+            let (line, column) = text
+                .lines()
+                .enumerate()
+                .find_map(|(i, l)| l.find(field).map(|c| (i + 1, c + 1)))
+                .unwrap_or((1, 1));
+            anyhow::anyhow!("{name}:{line}:{column}: {e}")
+        })?;
         Ok(s)
     }
 
@@ -154,6 +163,17 @@ mod tests {
             ..Default::default()
         };
         assert!(bad.validate().unwrap_err().contains("passed_fraction"));
+    }
+
+    #[test]
+    fn a_bad_settings_file_is_named_with_the_line_and_column() {
+        let path =
+            std::env::temp_dir().join(format!("orthosim-settings-{}.ron", std::process::id()));
+        std::fs::write(&path, "(\n    step_s: 0.02,\n    restitution: 7.0,\n)\n").unwrap();
+        let e = MovementSettings::load(&path).unwrap_err().to_string();
+        let _ = std::fs::remove_file(&path);
+        assert!(e.contains(":3:5: movement setting restitution"), "{e}");
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
     }
 
     #[test]

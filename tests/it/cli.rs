@@ -570,3 +570,39 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
     assert_eq!(std::fs::read(&case).unwrap(), before);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn outputs_never_replace_the_case_file_being_read() {
+    let dir = std::env::temp_dir().join(format!("orthosim-cli-inputs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = "Case(name: \"odd\", teeth: Only([11, 21]))\n";
+    for (name, args) in [
+        (
+            "index.html",
+            vec!["report", "--max-steps", "1", "--fit-depths", "2"],
+        ),
+        ("shot.png", vec!["screenshot"]),
+    ] {
+        let case = dir.join(name);
+        std::fs::write(&case, text).unwrap();
+        let mut all: Vec<&str> = args.clone();
+        all.extend(["--case", case.to_str().unwrap(), "--out"]);
+        let out_arg = if name.ends_with(".png") {
+            case.to_str().unwrap().to_owned()
+        } else {
+            dir.to_str().unwrap().to_owned()
+        };
+        all.push(&out_arg);
+        let out = orthosim(&all);
+        assert!(!out.status.success(), "{name}: the input was overwritten");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("refusing to overwrite"), "{name}: {err}");
+        assert_eq!(
+            std::fs::read_to_string(&case).unwrap(),
+            text,
+            "{name} changed"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
