@@ -100,6 +100,7 @@ fn an_exported_case_reads_back_with_the_same_geometry() {
             a.fdi
         );
     }
+    println!("round trip: vertices within {worst:e} mm");
     assert!(worst <= 1e-4, "vertices moved by {worst} mm");
     // Gaps between neighbours are the same.
     for (a, b) in d.neighbour_pairs() {
