@@ -816,7 +816,11 @@ fn dedup(points: &mut Vec<Vec3>) {
 /// following the farthest point.
 fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
     let fit = |c: Vec3| {
-        let r = points.iter().map(|p| p.distance(c)).fold(0.0f32, f32::max);
+        let r = points
+            .iter()
+            .map(|p| p.distance_squared(c))
+            .fold(0.0f32, f32::max)
+            .sqrt();
         let s = Sphere::new(c, padded(r));
         (columns.outside_volume(&s), s)
     };
