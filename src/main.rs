@@ -597,23 +597,10 @@ fn list_cases() {
     }
 }
 
-/// Refuses to write `output` when it is one of the command's input files (the case file named by
-/// `case`, when it is a file): outputs never replace inputs.
+/// Refuses to write `output` over the case file named by `case` (when it is a file).
 fn never_overwrite(output: &std::path::Path, case: &str) -> Result<()> {
-    let same = match (
-        std::fs::canonicalize(output),
-        std::fs::canonicalize(std::path::Path::new(case)),
-    ) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same {
-        anyhow::bail!(
-            "{}: refusing to overwrite the case file being read",
-            output.display()
-        );
-    }
-    Ok(())
+    orthosim::sphere_tree::report::refuse_overwriting(output, &[std::path::Path::new(case)])
+        .map_err(anyhow::Error::msg)
 }
 
 fn run_export_case(case: &str, out: &std::path::Path) -> Result<()> {

@@ -25,7 +25,7 @@ use crate::{
     movement::{MovementSettings, Response, report::run_case},
     sphere_tree::{
         TreeCache, TreeMethod, TreeSettings,
-        report::{trees_report, write_atomic},
+        report::{refuse_overwriting, trees_report, write_atomic},
     },
     teeth::{Arch, Case, Dentition},
 };
@@ -129,22 +129,16 @@ pub fn run_report(
         .iter()
         .map(|n| out.join(n))
         .collect();
-    let mut inputs = Vec::new();
+    let mut resolved = Vec::new();
     for case in &opts.cases {
         let loaded = Case::resolve(case)?;
         outputs.push(out.join(format!("{}.svg", loaded.case.name)));
         outputs.push(out.join(format!("{}.png", loaded.case.name)));
-        if let Ok(p) = std::fs::canonicalize(case) {
-            inputs.push(p);
-        }
+        resolved.push(loaded);
     }
+    let inputs: Vec<&Path> = opts.cases.iter().map(Path::new).collect();
     for o in &outputs {
-        if std::fs::canonicalize(o).is_ok_and(|p| inputs.contains(&p)) {
-            anyhow::bail!(
-                "{}: refusing to overwrite a case file being read",
-                o.display()
-            );
-        }
+        refuse_overwriting(o, &inputs).map_err(anyhow::Error::msg)?;
     }
     let total = opts.cases.len() * (Method::ALL.len() + 1) + 2 * opts.fit_depths.len();
     let mut done = 0;
@@ -153,8 +147,7 @@ pub fn run_report(
     let mut ipr = BTreeMap::new();
     let mut occlusion = BTreeMap::new();
     let mut plots = Vec::new();
-    for case in &opts.cases {
-        let loaded = Case::resolve(case)?;
+    for (case, loaded) in opts.cases.iter().zip(resolved) {
         let name = loaded.case.name.clone();
         let opening = loaded.case.bite_opening_mm.0;
         let mut per_method = BTreeMap::new();

@@ -278,10 +278,15 @@ fn edit_teeth(
             })
             .collect();
         for (e, t) in state.entities.iter().zip(&sim.teeth) {
-            commands.entity(*e).try_insert((
-                ToothMotion(Motion::still(t.pose)),
-                Transform::from_translation(t.pose.translation).with_rotation(t.pose.rotation),
-            ));
+            commands
+                .entity(*e)
+                .try_insert(ToothMotion(Motion::still(t.pose)));
+            // The restored tooth goes back to its place in the case.
+            if *e == m.tooth {
+                commands.entity(*e).try_insert(
+                    Transform::from_translation(t.pose.translation).with_rotation(t.pose.rotation),
+                );
+            }
         }
     }
 }

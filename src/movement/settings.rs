@@ -99,22 +99,26 @@ impl MovementSettings {
                 e.code
             )
         })?;
-        s.validate().map_err(|e| {
-            // Point at the offending field (the message names it).
-            let field = e.split_whitespace().nth(2).unwrap_or("");
+        if let Some((field, e)) = s.invalid_field() {
+            // Point at the offending field.
             let (line, column) = text
                 .lines()
                 .enumerate()
                 .find_map(|(i, l)| l.find(field).map(|c| (i + 1, c + 1)))
                 .unwrap_or((1, 1));
-            anyhow::anyhow!("{name}:{line}:{column}: {e}")
-        })?;
+            anyhow::bail!("{name}:{line}:{column}: {e}");
+        }
         Ok(s)
     }
 
     /// Checks that every parameter is finite and in range; the message names the field.
     pub fn validate(&self) -> Result<(), String> {
-        let checks: [(&str, f32, f32, f32); 9] = [
+        self.invalid_field().map_or(Ok(()), |(_, e)| Err(e))
+    }
+
+    /// The first parameter out of range, and the message naming it.
+    fn invalid_field(&self) -> Option<(&'static str, String)> {
+        let checks: [(&'static str, f32, f32, f32); 9] = [
             ("step_s", self.step_s, 1e-6, 10.0),
             (
                 "translational_mobility",
@@ -137,12 +141,13 @@ impl MovementSettings {
         ];
         for (name, v, lo, hi) in checks {
             if !v.is_finite() || v < lo || v > hi {
-                return Err(format!(
-                    "movement setting {name} must be in {lo}–{hi}, got {v}"
+                return Some((
+                    name,
+                    format!("movement setting {name} must be in {lo}–{hi}, got {v}"),
                 ));
             }
         }
-        Ok(())
+        None
     }
 }
 

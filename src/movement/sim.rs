@@ -438,14 +438,13 @@ impl Simulation {
             }
         }
         let mut next = Self::new(&edited, shapes, self.method, self.settings)?;
+        // (A restored tooth starts from the case: its initial pose, load and wire.)
         for t in &mut next.teeth {
             if let Some(i) = self.index_of(t.fdi) {
                 let old = &self.teeth[i];
                 t.initial = old.initial;
                 t.load = old.load;
                 t.wire = old.wire;
-            } else {
-                t.initial = placed.pose;
             }
         }
         for (g, old) in next.groups.iter_mut().zip(&self.groups) {

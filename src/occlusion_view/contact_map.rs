@@ -136,16 +136,21 @@ pub(super) fn update_contact_map(
         let Some(crown) = assets.crown_vertices(shape) else {
             continue;
         };
+        // World to each antagonist's frame, once per tooth rather than per vertex.
+        let to_local: Vec<_> = antagonists
+            .iter()
+            .map(|o| (o.3.compute_affine().inverse(), o.2))
+            .collect();
         let colours: Vec<[f32; 4]> = crown
             .iter()
             .map(|&i| {
                 let p = tf.transform_point(shape.mesh.vertices[i as usize]);
                 let mut best = f32::INFINITY;
-                for o in &antagonists {
-                    let local = o.3.compute_affine().inverse().transform_point3(p);
+                for (inverse, other) in &to_local {
+                    let local = inverse.transform_point3(p);
                     let m = MeshRef {
-                        mesh: &o.2.mesh,
-                        bvh: &o.2.bvh,
+                        mesh: &other.mesh,
+                        bvh: &other.bvh,
                     };
                     if let Some((_, d)) = closest_point_on_mesh(m, local) {
                         let d = if d <= 1.0 && point_inside_mesh(m, local) {
@@ -176,9 +181,14 @@ pub(super) fn update_contact_map(
             None => false,
         };
         if !updated {
-            let mesh = super::tooth_render::render_parts(&shape)
-                .0
-                .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, colours);
+            // A coloured copy of the shape's shared crown mesh.
+            let Some(mesh) = assets
+                .crown_mesh(&shape)
+                .and_then(|h| meshes.get(&h).cloned())
+            else {
+                continue;
+            };
+            let mesh = mesh.with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, colours);
             let handle = meshes.add(mesh);
             commands.entity(e).insert((
                 MapMesh(handle.clone()),

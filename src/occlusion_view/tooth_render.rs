@@ -36,10 +36,25 @@ impl ToothRenderAssets {
         shape: &ToothShape,
         arch: Arch,
     ) -> (Option<Handle<Mesh>>, Option<Handle<StandardMaterial>>) {
-        (
-            self.meshes.get(&key(shape)).map(|m| m.crown.clone()),
-            self.materials.get(&arch).cloned(),
-        )
+        (self.crown_mesh(shape), self.materials.get(&arch).cloned())
+    }
+
+    /// The shared root material of an arch in a style (made on first use).
+    fn root_material(
+        &mut self,
+        materials: &mut Assets<StandardMaterial>,
+        style: Roots,
+        arch: Arch,
+    ) -> Handle<StandardMaterial> {
+        self.root_materials
+            .entry((arch, style))
+            .or_insert_with(|| materials.add(root_material(style, arch)))
+            .clone()
+    }
+
+    /// The shared crown mesh of a shape, once made.
+    pub(super) fn crown_mesh(&self, shape: &ToothShape) -> Option<Handle<Mesh>> {
+        self.meshes.get(&key(shape)).map(|m| m.crown.clone())
     }
 
     /// The shape's mesh vertex behind each vertex of its crown mesh, once made.
@@ -65,7 +80,7 @@ type Part = (Vec<u32>, Vec<u32>, HashMap<u32, u32>);
 /// The crown and root parts of a tooth mesh, split at the cervical plane (a triangle belongs to
 /// the crown when its centroid lies on the occlusal side), with smooth normals of the whole mesh so
 /// the seam does not show. Also the mesh vertex behind each crown vertex.
-pub(super) fn render_parts(shape: &ToothShape) -> (Mesh, Vec<u32>, Mesh) {
+fn render_parts(shape: &ToothShape) -> (Mesh, Vec<u32>, Mesh) {
     let m = &shape.mesh;
     let normals = m.vertex_normals();
     let (cervical, axis) = (shape.frame.cervical_centre, shape.frame.long_axis);
@@ -162,11 +177,7 @@ pub(super) fn attach_tooth_meshes(
                 })
             })
             .clone();
-        let root_material = assets
-            .root_materials
-            .entry((arch, overlays.roots))
-            .or_insert_with(|| materials.add(root_material(overlays.roots, arch)))
-            .clone();
+        let root_material = assets.root_material(&mut materials, overlays.roots, arch);
         commands
             .entity(entity)
             .insert((Mesh3d(crown), MeshMaterial3d(material)))
@@ -211,11 +222,7 @@ pub(super) fn root_style(
             continue;
         };
         let arch = tooth.id.arch();
-        let want = assets
-            .root_materials
-            .entry((arch, overlays.roots))
-            .or_insert_with(|| materials.add(root_material(overlays.roots, arch)))
-            .clone();
+        let want = assets.root_material(&mut materials, overlays.roots, arch);
         if material.0 != want {
             material.0 = want;
         }

@@ -175,6 +175,24 @@ pub fn trees_report(
     ))
 }
 
+/// Refuses to write `output` over one of `inputs` (compared as canonical paths, so relative paths
+/// and links count): outputs never replace the files a command reads.
+pub fn refuse_overwriting(output: &Path, inputs: &[&Path]) -> Result<(), String> {
+    let Ok(out) = std::fs::canonicalize(output) else {
+        return Ok(());
+    };
+    if inputs
+        .iter()
+        .any(|i| std::fs::canonicalize(i).is_ok_and(|i| i == out))
+    {
+        return Err(format!(
+            "{}: refusing to overwrite a file this command reads",
+            output.display()
+        ));
+    }
+    Ok(())
+}
+
 /// Writes `text` to `path` atomically: a temporary file beside it, then a rename, so a reader never
 /// sees half a file.
 pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {

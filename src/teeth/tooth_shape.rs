@@ -39,29 +39,20 @@ impl ToothGeometry {
         let an = anatomy(arch, kind);
         let solid = ToothSolid::new(arch, kind, an);
         let mesh = solid.mesh(resolution);
-        let frame = ToothFrame::from_mesh(
-            &mesh,
-            Vec3::ZERO,
-            Vec3::Y,
-            Vec3::Z,
-            CentreParameters::default(),
-        );
-        let bvh = TriangleBvh::build(&mesh);
-        Self {
-            arch,
-            kind,
-            anatomy: an,
-            cusp_tips: solid.cusp_tips(),
-            mesh,
-            bvh,
-            frame,
-        }
+        Self::from_local_mesh(arch, kind, mesh, solid.cusp_tips())
     }
 
     /// The geometry of an imported tooth from its closed mesh in its local frame (origin at the
     /// cervical centre, y occlusal, z buccal; see [`super::import`]). Dimensions are the anatomy
     /// table's for the type.
     pub fn imported(arch: Arch, kind: ToothKind, mesh: TriMesh) -> Self {
+        let cusp_tips = super::import::cusp_tips(&mesh, kind);
+        Self::from_local_mesh(arch, kind, mesh, cusp_tips)
+    }
+
+    /// A tooth from its closed mesh in its local frame (cervical centre at the origin, y occlusal,
+    /// z buccal): frame, triangle hierarchy and the type's anatomy.
+    fn from_local_mesh(arch: Arch, kind: ToothKind, mesh: TriMesh, cusp_tips: Vec<Vec3>) -> Self {
         let frame = ToothFrame::from_mesh(
             &mesh,
             Vec3::ZERO,
@@ -74,7 +65,7 @@ impl ToothGeometry {
             arch,
             kind,
             anatomy: anatomy(arch, kind),
-            cusp_tips: super::import::cusp_tips(&mesh, kind),
+            cusp_tips,
             mesh,
             bvh,
             frame,

@@ -9,6 +9,25 @@ fn orthosim(args: &[&str]) -> std::process::Output {
         .expect("the orthosim binary runs")
 }
 
+/// Runs `orthosim` with `args`, which must succeed, and parses its one JSON object.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let out = orthosim(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+/// An empty folder private to this test process.
+fn fresh_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("orthosim-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 #[test]
 fn cases_lists_the_four_builtin_cases() {
     let out = orthosim(&["cases"]);
@@ -470,8 +489,7 @@ fn report_writes_every_file_its_page_refers_to() {
 
 #[test]
 fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
-    let dir = std::env::temp_dir().join(format!("orthosim-cli-export-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = fresh_dir("export");
     let out = orthosim(&[
         "export-case",
         "--case",
@@ -498,15 +516,7 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
             .count(),
         32
     );
-    let inspect = |case: &str| {
-        let out = orthosim(&["inspect", "--case", case, "--json"]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
-    };
+    let inspect = |case: &str| json_of(&["inspect", "--case", case, "--json"]);
     let (a, b) = (inspect("case1"), inspect(case.to_str().unwrap()));
     assert_eq!(b["imported"].as_array().unwrap().len(), 32);
     for m in b["imported"].as_array().unwrap() {
@@ -527,7 +537,7 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
     }
     // The imported case simulates like the original: the same teeth move, about as far.
     let simulate = |case: &str| {
-        let out = orthosim(&[
+        json_of(&[
             "simulate",
             "--case",
             case,
@@ -537,13 +547,7 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
             "--max-steps",
             "300",
             "--json",
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+        ])
     };
     let (sa, sb) = (simulate("case1"), simulate(case.to_str().unwrap()));
     assert_eq!(sa["moved"], sb["moved"]);
@@ -573,9 +577,7 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
 
 #[test]
 fn outputs_never_replace_the_case_file_being_read() {
-    let dir = std::env::temp_dir().join(format!("orthosim-cli-inputs-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = fresh_dir("inputs");
     let text = "Case(name: \"odd\", teeth: Only([11, 21]))\n";
     for (name, args) in [
         (

@@ -9,7 +9,7 @@ use orthosim::{
     teeth::{
         Dentition,
         arch::ArchCurve,
-        import::{RepairLimits, import_mesh, read_mesh, write_stl},
+        import::{RepairLimits, import_mesh, read_mesh},
     },
 };
 use proptest::prelude::*;
@@ -122,38 +122,9 @@ fn mesh_files() -> &'static [(&'static str, Vec<u8>)] {
 }
 
 fn make_mesh_files() -> Vec<(&'static str, Vec<u8>)> {
-    let d = normal();
-    let t = d.tooth(Fdi::new(11).unwrap()).unwrap();
+    let t = normal().tooth(Fdi::new(11).unwrap()).unwrap();
     let m = t.geometry.mesh.map_vertices(|v| t.pose.transform_point(v));
-    let mut stl = Vec::new();
-    write_stl(&m, &mut stl).unwrap();
-    let mut ascii = String::from("solid t\n");
-    let mut obj = String::new();
-    let mut ply = format!(
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
-        m.vertices.len(),
-        m.triangles.len()
-    );
-    for v in &m.vertices {
-        obj.push_str(&format!("v {} {} {}\n", v.x, v.y, v.z));
-        ply.push_str(&format!("{} {} {}\n", v.x, v.y, v.z));
-    }
-    for (i, t) in m.triangles.iter().enumerate() {
-        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-        ply.push_str(&format!("3 {} {} {}\n", t[0], t[1], t[2]));
-        ascii.push_str("facet normal 0 0 0\nouter loop\n");
-        for v in m.triangle(i) {
-            ascii.push_str(&format!("vertex {} {} {}\n", v.x, v.y, v.z));
-        }
-        ascii.push_str("endloop\nendfacet\n");
-    }
-    ascii.push_str("endsolid t\n");
-    vec![
-        ("stl", stl),
-        ("stl", ascii.into_bytes()),
-        ("obj", obj.into_bytes()),
-        ("ply", ply.into_bytes()),
-    ]
+    crate::mesh_files::every_format(&m)
 }
 
 proptest! {

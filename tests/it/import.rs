@@ -63,20 +63,15 @@ fn an_exported_case_reads_back_with_the_same_geometry() {
             a.fdi,
             back.imported[&a.fdi]
         );
-        let wa: Vec<Vec3> = a
-            .geometry
-            .mesh
-            .vertices
-            .iter()
-            .map(|v| a.pose.transform_point(*v))
-            .collect();
-        let wb: Vec<Vec3> = b
-            .geometry
-            .mesh
-            .vertices
-            .iter()
-            .map(|v| b.pose.transform_point(*v))
-            .collect();
+        let world = |t: &orthosim::teeth::PlacedTooth| -> Vec<Vec3> {
+            t.geometry
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| t.pose.transform_point(*v))
+                .collect()
+        };
+        let (wa, wb) = (world(a), world(b));
         assert_eq!(wa.len(), wb.len(), "{}", a.fdi);
         assert_eq!(
             a.geometry.mesh.triangles.len(),
@@ -119,6 +114,20 @@ fn an_exported_case_reads_back_with_the_same_geometry() {
     // The exported case is not overwritten by exporting it onto itself.
     let again = export_case(&back, &dir).unwrap_err();
     assert!(again.contains("refusing"), "{again}");
+    // Nor are its mesh files, read by a case kept elsewhere; nothing is written then.
+    let text = std::fs::read_to_string(&report.case_file).unwrap();
+    let moved = text
+        .replace("file: \"", "file: \"../")
+        .replace("name: \"normal\"", "name: \"moved\"");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    std::fs::write(dir.join("sub/moved.ron"), moved).unwrap();
+    let elsewhere = Dentition::build(Case::load(&dir.join("sub/moved.ron")).unwrap()).unwrap();
+    let again = export_case(&elsewhere, &dir).unwrap_err();
+    assert!(
+        again.contains("refusing") && again.contains(".stl"),
+        "{again}"
+    );
+    assert!(!dir.join("moved.ron").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -127,40 +136,16 @@ fn stl_obj_and_ply_files_read_alike() {
     let dir = temp_dir("formats");
     let d = normal();
     let (mesh, _, _) = world_tooth(&d, 21);
-    let mut stl = Vec::new();
-    write_stl(&mesh, &mut stl).unwrap();
-    std::fs::write(dir.join("21.stl"), &stl).unwrap();
-    let mut ascii = String::from("solid tooth\n");
-    for i in 0..mesh.triangles.len() {
-        ascii.push_str("facet normal 0 0 0\nouter loop\n");
-        for v in mesh.triangle(i) {
-            ascii.push_str(&format!("vertex {} {} {}\n", v.x, v.y, v.z));
-        }
-        ascii.push_str("endloop\nendfacet\n");
+    let mut names = Vec::new();
+    for (k, (ext, bytes)) in crate::mesh_files::every_format(&mesh)
+        .into_iter()
+        .enumerate()
+    {
+        let name = format!("21-{k}.{ext}");
+        std::fs::write(dir.join(&name), bytes).unwrap();
+        names.push(name);
     }
-    ascii.push_str("endsolid tooth\n");
-    std::fs::write(dir.join("21a.stl"), ascii).unwrap();
-    let mut obj = String::new();
-    for v in &mesh.vertices {
-        obj.push_str(&format!("v {} {} {}\n", v.x, v.y, v.z));
-    }
-    for t in &mesh.triangles {
-        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-    }
-    std::fs::write(dir.join("21.obj"), obj).unwrap();
-    let mut ply = format!(
-        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
-        mesh.vertices.len(),
-        mesh.triangles.len()
-    );
-    for v in &mesh.vertices {
-        ply.push_str(&format!("{} {} {}\n", v.x, v.y, v.z));
-    }
-    for t in &mesh.triangles {
-        ply.push_str(&format!("3 {} {} {}\n", t[0], t[1], t[2]));
-    }
-    std::fs::write(dir.join("21.ply"), ply).unwrap();
-    for name in ["21.stl", "21a.stl", "21.obj", "21.ply"] {
+    for name in &names {
         let read = orthosim::teeth::import::read_mesh(&dir.join(name)).unwrap();
         let t = import(&read, 21).unwrap();
         let w = world_of(&t);

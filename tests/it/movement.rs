@@ -302,11 +302,11 @@ fn ipr_records_the_overlap_within_its_limit() {
     assert!(r.report.at_rest);
 }
 
-#[test]
-fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
+/// A headless app with `case` loaded, updated until its simulation has started (every tooth has
+/// its tree), or for about 15 s.
+fn simulating_app(case: &str) -> App {
     let mut app = create_app();
-    app.world_mut().write_message(LoadCase("case1".into()));
-    // Wait for the case and its (octree, the plugin's default) trees.
+    app.world_mut().write_message(LoadCase(case.into()));
     for _ in 0..3000 {
         app.update();
         if app.world().resource::<SimulationState>().sim.is_some() {
@@ -314,6 +314,13 @@ fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
         }
         std::thread::sleep(Duration::from_millis(5));
     }
+    app
+}
+
+#[test]
+fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
+    // The case with its (octree, the plugin's default) trees.
+    let mut app = simulating_app("case1");
     let start = app.world().resource::<MovementStatus>().steps;
     assert!(app.world().resource::<SimulationState>().sim.is_some());
     for _ in 0..150 {
@@ -408,15 +415,7 @@ fn long_runs_stay_finite_and_at_rest() {
 #[test]
 fn a_load_set_by_message_moves_its_tooth() {
     use orthosim::movement::{SetGroupLoad, SetLoad};
-    let mut app = create_app();
-    app.world_mut().write_message(LoadCase("normal".into()));
-    for _ in 0..3000 {
-        app.update();
-        if app.world().resource::<SimulationState>().sim.is_some() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    let mut app = simulating_app("normal");
     let mut q = app.world_mut().query::<(Entity, &Tooth, &Transform)>();
     let (e11, before) = q
         .iter(app.world())
@@ -590,15 +589,7 @@ fn teeth_are_extracted_and_restored_while_the_case_runs() {
 fn wires_extractions_and_restorations_by_message() {
     use orthosim::movement::{SetExtracted, SetWire};
     use orthosim::teeth::{Extracted, Wire, WireModel};
-    let mut app = create_app();
-    app.world_mut().write_message(LoadCase("normal".into()));
-    for _ in 0..3000 {
-        app.update();
-        if app.world().resource::<SimulationState>().sim.is_some() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    let mut app = simulating_app("normal");
     let mut q = app.world_mut().query::<(Entity, &Tooth)>();
     let mut find = |app: &mut App, n: u8| {
         q.iter(app.world())

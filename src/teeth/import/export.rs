@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::{MeshTransform, ToothMeshFile, Units, write_stl};
 use crate::{
-    sphere_tree::report::write_atomic_bytes,
+    sphere_tree::report::{refuse_overwriting, write_atomic_bytes},
     teeth::{
         Dentition,
         case::{Case, ToothMap},
@@ -27,18 +27,25 @@ pub struct ExportReport {
 }
 
 /// Writes the teeth of `d` to `dir` (created if needed) as `NN.stl` and the case as `NAME.ron`.
-/// Files are written atomically; an existing file of the same name is replaced only if it is not
-/// the case file `d` was read from.
+/// Files are written atomically; the case file `d` was read from and its mesh files are never
+/// replaced.
 pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let source = Path::new(&d.case.origin);
     let mut case: Case = d.case.case.clone();
     let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
-    if same_file(&case_file, source) {
-        return Err(format!(
-            "{}: refusing to overwrite the case being exported",
-            case_file.display()
-        ));
+    // Never replace what is read: the case file and its mesh files.
+    let mut inputs = vec![source.to_owned()];
+    inputs.extend(
+        case.meshes
+            .0
+            .values()
+            .map(|m| Case::mesh_path(&d.case.origin, &m.file)),
+    );
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    refuse_overwriting(&case_file, &inputs)?;
+    for t in &d.teeth {
+        refuse_overwriting(&dir.join(format!("{}.stl", t.fdi.number())), &inputs)?;
     }
     let mut meshes = Vec::new();
     let mut files = ToothMap::default();
@@ -95,11 +102,4 @@ fn file_stem(name: &str) -> String {
         })
         .collect();
     if s.is_empty() { "case".into() } else { s }
-}
-
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
 }

@@ -43,6 +43,7 @@ use crate::geometry::{MassProperties, MeshError, Pose, TriMesh};
 
 pub use export::{ExportReport, export_case};
 pub use read::{MeshFormat, read_mesh, write_stl};
+use repair::near;
 pub use repair::{RepairLimits, Repairs};
 
 /// Units of a mesh file.
@@ -217,10 +218,6 @@ pub fn import_mesh(
         pose,
         repairs,
     })
-}
-
-fn near(v: Vec3) -> String {
-    format!("near ({:.3}, {:.3}, {:.3}) mm", v.x, v.y, v.z)
 }
 
 /// A mesh error with the place it is at.

@@ -118,7 +118,8 @@ pub(super) struct OpenSurface {
     pub loops: Vec<Vec<u32>>,
 }
 
-fn near(v: Vec3) -> String {
+/// Where something is, for messages.
+pub(super) fn near(v: Vec3) -> String {
     format!("near ({:.3}, {:.3}, {:.3}) mm", v.x, v.y, v.z)
 }
 
