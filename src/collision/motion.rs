@@ -144,6 +144,16 @@ impl<T: Copy + Default> NodeCache<T> {
         }
     }
 
+    /// The value of node `i` by reference, computed by `f` on first use in this query.
+    #[inline]
+    pub(crate) fn get_ref(&mut self, i: usize, f: impl FnOnce() -> T) -> &T {
+        if self.stamps[i] != self.now {
+            self.values[i] = f();
+            self.stamps[i] = self.now;
+        }
+        &self.values[i]
+    }
+
     /// The value of node `i`, computed by `f` on first use in this query.
     #[inline]
     pub(crate) fn get(&mut self, i: usize, f: impl FnOnce() -> T) -> T {

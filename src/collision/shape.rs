@@ -11,6 +11,39 @@ use crate::{
     teeth::{Dentition, Fdi, ToothGeometry},
 };
 
+/// Lanes of a [`Chunk`]: the children of a node are tested against one sphere eight at a time.
+pub const LANES: usize = 8;
+
+/// Up to [`LANES`] sibling spheres in structure-of-arrays form, so that one node is tested against
+/// all of them in a few vector instructions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Chunk {
+    /// Centre x (local frame).
+    pub x: [f32; LANES],
+    /// Centre y.
+    pub y: [f32; LANES],
+    /// Centre z.
+    pub z: [f32; LANES],
+    /// Radius.
+    pub r: [f32; LANES],
+    /// Distance of the centre from the local origin.
+    pub rho: [f32; LANES],
+    /// Compact node index of each lane.
+    pub node: [u32; LANES],
+    /// Lanes in use (the first `len`).
+    pub len: u32,
+    /// Bit k set when lane k is a leaf.
+    pub leaves: u32,
+}
+
+impl Chunk {
+    /// Bit k set for every lane in use.
+    #[inline]
+    pub fn used(&self) -> u32 {
+        (1u32 << self.len) - 1
+    }
+}
+
 /// A sphere tree without empty slots, children stored contiguously, for fast descent.
 #[derive(Clone, Debug)]
 pub struct CompactTree {
@@ -24,6 +57,12 @@ pub struct CompactTree {
     pub count: Vec<u32>,
     /// Triangles each leaf touches (empty for inner nodes).
     pub triangles: Vec<Vec<u32>>,
+    /// Sibling groups in lanes: chunk 0 holds the root alone, then each inner node's children.
+    pub chunks: Vec<Chunk>,
+    /// Per node, the range of chunks holding its children (empty for a leaf).
+    pub child_chunks: Vec<std::ops::Range<u32>>,
+    /// Largest distance of a node centre from the local origin (for rounding bounds).
+    pub max_rho: f32,
 }
 
 impl CompactTree {
@@ -35,6 +74,9 @@ impl CompactTree {
             first: Vec::new(),
             count: Vec::new(),
             triangles: Vec::new(),
+            chunks: Vec::new(),
+            child_chunks: Vec::new(),
+            max_rho: 0.0,
         };
         let Some(root) = tree.root() else {
             return out;
@@ -62,7 +104,45 @@ impl CompactTree {
             }
         }
         out.rho = out.spheres.iter().map(|s| s.centre.length()).collect();
+        out.max_rho = out.rho.iter().copied().fold(0.0, f32::max);
+        out.pack();
         out
+    }
+
+    /// Fills `chunks` and `child_chunks` from the node arrays.
+    fn pack(&mut self) {
+        let lane = |chunk: &mut Chunk, k: usize, node: usize, s: &Sphere, rho: f32| {
+            chunk.x[k] = s.centre.x;
+            chunk.y[k] = s.centre.y;
+            chunk.z[k] = s.centre.z;
+            chunk.r[k] = s.radius;
+            chunk.rho[k] = rho;
+            chunk.node[k] = node as u32;
+            chunk.len = k as u32 + 1;
+        };
+        let leaf = |chunk: &mut Chunk, k: usize, node: usize, count: &[u32]| {
+            if count[node] == 0 {
+                chunk.leaves |= 1 << k;
+            }
+        };
+        let mut root = Chunk::default();
+        lane(&mut root, 0, 0, &self.spheres[0], self.rho[0]);
+        leaf(&mut root, 0, 0, &self.count);
+        self.chunks = vec![root];
+        self.child_chunks = Vec::with_capacity(self.spheres.len());
+        for i in 0..self.spheres.len() {
+            let start = self.chunks.len() as u32;
+            let kids: Vec<usize> = self.children(i).collect();
+            for group in kids.chunks(LANES) {
+                let mut c = Chunk::default();
+                for (k, &n) in group.iter().enumerate() {
+                    lane(&mut c, k, n, &self.spheres[n], self.rho[n]);
+                    leaf(&mut c, k, n, &self.count);
+                }
+                self.chunks.push(c);
+            }
+            self.child_chunks.push(start..self.chunks.len() as u32);
+        }
     }
 
     /// True when node `i` has no children.

@@ -51,7 +51,10 @@ fn closest_point_triangle_f64(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
         return b + (c - b) * w;
     }
     let sum = va + vb + vc;
-    if sum.abs() <= f64::MIN_POSITIVE {
+    // sum = |ab × ac|²: a needle (sine below 10⁻⁶) or a point has no reliable face region.
+    if sum.abs() <= 1e-12 * ab.length_squared() * ac.length_squared()
+        || sum.abs() <= f64::MIN_POSITIVE
+    {
         // A degenerate triangle: the nearest of its edges.
         return [(a, b), (b, c), (c, a)]
             .into_iter()
@@ -209,12 +212,146 @@ pub fn segment_triangle_crossing(p: Vec3, q: Vec3, t: &[Vec3; 3]) -> Option<Vec3
     (0.0..=1.0).contains(&tt).then(|| p + d * tt)
 }
 
-/// Exact closest points between two triangles (Ericson 5.1.9's reduction: for disjoint triangles
-/// the minimum is reached between a vertex and the other triangle or between two edges). When the
-/// triangles intersect the distance is 0 and both points are a point where an edge of one crosses
-/// the other.
+/// Exact closest points between two triangles. When the triangles intersect the distance is 0
+/// and both points are a point where an edge of one crosses the other.
+///
+/// For disjoint triangles the minimum is reached between two edges or between a vertex and the
+/// other's face (Ericson 5.1.9). The nine edge pairs come first, in f64: an edge pair whose closest
+/// points P, Q leave each triangle's third vertex on its own side of the slab between the planes
+/// through P and Q normal to Q − P is the answer at once (the slab separates the triangles; Larsen
+/// and Gottschalk's test in PQP). Otherwise a vertex of one triangle is the answer when the whole
+/// triangle lies on one side of the other's plane and that nearest vertex projects into the other
+/// face; otherwise, if some axis showed the triangles apart, the best edge pair is. Triangles not
+/// shown apart touch or intersect and take the exhaustive path (every vertex–face and edge–edge
+/// pair, and a crossing point).
 pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
-    if triangles_intersect(t1, t2) {
+    let s = t1.map(|v| v.as_dvec3());
+    let t = t2.map(|v| v.as_dvec3());
+    let pair = |d2: f64, p: DVec3, q: DVec3| TrianglePair {
+        distance: d2.sqrt() as f32,
+        on_first: p.as_vec3(),
+        on_second: q.as_vec3(),
+    };
+    let mut shown_apart = false;
+    let mut best = (f64::INFINITY, s[0], t[0]);
+    for i in 0..3 {
+        for j in 0..3 {
+            let (p, q) = segment_points_f64(s[i], s[(i + 1) % 3], t[j], t[(j + 1) % 3]);
+            let v = q - p;
+            let dd = v.length_squared();
+            if dd <= best.0 {
+                best = (dd, p, q);
+                let a = (s[(i + 2) % 3] - p).dot(v);
+                let b = (t[(j + 2) % 3] - q).dot(v);
+                if a <= 0.0 && b >= 0.0 {
+                    return pair(dd, p, q);
+                }
+                // Extent of each triangle along v beyond its closest point: apart along v when
+                // the gap |v|² exceeds them.
+                if dd - a.max(0.0) + b.min(0.0) > 0.0 {
+                    shown_apart = true;
+                }
+            }
+        }
+    }
+    for (first, other, swapped) in [(&s, &t, false), (&t, &s, true)] {
+        if let Some((point, on_face)) = vertex_over_face(first, other, &mut shown_apart) {
+            let (p, q) = if swapped {
+                (point, on_face)
+            } else {
+                (on_face, point)
+            };
+            return pair(p.distance_squared(q), p, q);
+        }
+    }
+    if shown_apart {
+        return pair(best.0, best.1, best.2);
+    }
+    exhaustive(t1, t2)
+}
+
+/// When `other` lies wholly on one side of `face`'s plane: its vertex nearest the plane, if that
+/// vertex projects into the face, with the projection. Sets `shown_apart` when the plane
+/// separates them.
+#[inline]
+fn vertex_over_face(
+    face: &[DVec3; 3],
+    other: &[DVec3; 3],
+    shown_apart: &mut bool,
+) -> Option<(DVec3, DVec3)> {
+    let e = [face[1] - face[0], face[2] - face[1], face[0] - face[2]];
+    let n = e[0].cross(e[1]);
+    let nl = n.length_squared();
+    // Needles (sine below 10⁻⁶): their normal is not trusted; their edges carry the answer.
+    if nl <= 1e-12 * e[0].length_squared() * e[1].length_squared() || nl == 0.0 {
+        return None;
+    }
+    let h = other.map(|v| (face[0] - v).dot(n));
+    let k = if h.iter().all(|&x| x > 0.0) {
+        (0..3).min_by(|&x, &y| h[x].total_cmp(&h[y]))?
+    } else if h.iter().all(|&x| x < 0.0) {
+        (0..3).max_by(|&x, &y| h[x].total_cmp(&h[y]))?
+    } else {
+        return None;
+    };
+    *shown_apart = true;
+    let v = other[k];
+    let inside = (0..3).all(|m| (v - face[m]).dot(n.cross(e[m])) > 0.0);
+    inside.then(|| (v, v + n * (h[k] / nl)))
+}
+
+/// Closest points of segments `p1 q1` and `p2 q2` in f64 (Ericson 5.1.9), degenerate segments
+/// included.
+#[inline]
+fn segment_points_f64(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> (DVec3, DVec3) {
+    const EPS: f64 = 1e-18;
+    let d1 = q1 - p1;
+    let d2 = q2 - p2;
+    let r = p1 - p2;
+    let a = d1.length_squared();
+    let e = d2.length_squared();
+    let f = d2.dot(r);
+    if a <= EPS && e <= EPS {
+        return (p1, p2);
+    }
+    let (s, t);
+    if a <= EPS {
+        s = 0.0;
+        t = (f / e).clamp(0.0, 1.0);
+    } else {
+        let c = d1.dot(r);
+        if e <= EPS {
+            t = 0.0;
+            s = (-c / a).clamp(0.0, 1.0);
+        } else {
+            let b = d1.dot(d2);
+            let denom = a * e - b * b;
+            let s0 = if denom > 1e-12 * a * e {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let t0 = (b * s0 + f) / e;
+            if t0 < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t0 > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            } else {
+                t = t0;
+                s = s0;
+            }
+        }
+    }
+    (p1 + d1 * s, p2 + d2 * t)
+}
+
+/// Every vertex–face and edge–edge pair, for triangles that touch or intersect (and as the
+/// reference in tests).
+fn exhaustive(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
+    let intersecting = triangles_intersect(t1, t2);
+    if intersecting {
         let crossing = (0..3)
             .find_map(|k| segment_triangle_crossing(t1[k], t1[(k + 1) % 3], t2))
             .or_else(|| (0..3).find_map(|k| segment_triangle_crossing(t2[k], t2[(k + 1) % 3], t1)));
@@ -254,10 +391,46 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
             consider(a, b);
         }
     }
-    if triangles_intersect(t1, t2) {
+    if intersecting {
         best.distance = 0.0;
     }
     best
+}
+
+/// A lower bound of the distance between two triangles: how far one lies beyond the other's
+/// plane (0 when neither lies wholly on one side, or a triangle is a needle). Computed in f64 and
+/// rounded down, so never above the exact distance.
+#[inline]
+pub fn triangle_plane_gap(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> f32 {
+    #[inline]
+    fn beyond(t: &[Vec3; 3], o: &[Vec3; 3]) -> f64 {
+        let p = t[0].as_dvec3();
+        let (e1, e2) = (t[1].as_dvec3() - p, t[2].as_dvec3() - p);
+        let n = e1.cross(e2);
+        let len2 = n.length_squared();
+        // Needles (sine of the angle below 10⁻⁶): the normal is not trusted.
+        if len2 <= 1e-12 * e1.length_squared() * e2.length_squared() || len2 == 0.0 {
+            return 0.0;
+        }
+        let d = o.map(|v| v.as_dvec3() - p);
+        let s = d.map(|v| n.dot(v));
+        let m = if s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0 {
+            s[0].min(s[1]).min(s[2])
+        } else if s[0] < 0.0 && s[1] < 0.0 && s[2] < 0.0 {
+            -(s[0].max(s[1]).max(s[2]))
+        } else {
+            return 0.0;
+        };
+        // The normal's direction is off by at most ~10⁻¹⁶ / sine ≤ 10⁻¹⁰ and each product by
+        // a few ulps: shrink by far more than both.
+        let scale = d
+            .iter()
+            .chain([&e1, &e2])
+            .map(|v| v.abs().max_element())
+            .fold(0.0, f64::max);
+        m / len2.sqrt() * (1.0 - 1e-9) - 1e-8 * scale
+    }
+    (beyond(t2, t1).max(beyond(t1, t2)).max(0.0) as f32) * (1.0 - 1e-6)
 }
 
 #[cfg(test)]
@@ -325,6 +498,113 @@ mod tests {
         assert!(!triangles_intersect(&t1, &t2));
         let r = closest_points_triangle_triangle(&t1, &t2);
         assert!((r.distance - 0.3).abs() < 1e-6, "{r:?}");
+    }
+
+    #[test]
+    fn plane_gap_is_a_lower_bound_and_tight_for_facing_triangles() {
+        let t1 = tri([0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+        // Parallel, 0.3 above: the bound is the distance.
+        let t2 = tri([0.2, 0.2, 0.3], [1.0, 0.2, 0.3], [0.2, 1.0, 0.3]);
+        let g = triangle_plane_gap(&t1, &t2);
+        assert!(g <= 0.3 && g > 0.2999, "{g}");
+        // Straddling the plane: no bound.
+        let t3 = tri([5.0, 0.0, -1.0], [5.0, 0.0, 1.0], [6.0, 0.0, 0.0]);
+        assert_eq!(triangle_plane_gap(&t1, &t3), 0.0);
+        // Random pairs: never above the exact distance.
+        let mut state = 99u32;
+        let mut rnd = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        for _ in 0..5000 {
+            let mut v = || Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+            let (a, b) = ([v(), v(), v()], [v(), v(), v()]);
+            let exact = closest_points_triangle_triangle(&a, &b).distance;
+            assert!(triangle_plane_gap(&a, &b) <= exact, "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn the_fast_triangle_distance_agrees_with_the_exhaustive_one() {
+        let mut state = 12345u32;
+        let mut rnd = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        let mut by_kind = [0usize; 3];
+        for n in 0..40_000 {
+            let mut v = |s: f32| Vec3::new(rnd(), rnd(), rnd()) * s;
+            let a = [v(4.0), v(4.0), v(4.0)];
+            let mut b = [v(4.0), v(4.0), v(4.0)];
+            match n % 4 {
+                // Nearly parallel and close, as teeth meet.
+                0 => {
+                    let lift = Vec3::Z * v(0.01).z.abs();
+                    let flat = Vec3::new(1.0, 1.0, 0.0);
+                    let a0 = a.map(|p| p * flat);
+                    let shift = v(1.0) * flat;
+                    b = a0.map(|p| p + shift + lift + v(0.001));
+                    check(&a0, &b, &mut by_kind);
+                    continue;
+                }
+                // A needle.
+                1 => b[2] = b[0] + (b[1] - b[0]) * 0.5 + v(1e-7),
+                _ => {}
+            }
+            check(&a, &b, &mut by_kind);
+        }
+        // Every outcome was exercised.
+        assert!(by_kind.iter().all(|&k| k > 100), "{by_kind:?}");
+
+        fn check(a: &[Vec3; 3], b: &[Vec3; 3], by_kind: &mut [usize; 3]) {
+            let fast = closest_points_triangle_triangle(a, b);
+            // Reference: 0 where an edge crosses the other triangle, else the nearest of the
+            // vertex–face and edge–edge pairs.
+            let crossing = (0..3).any(|k| {
+                segment_triangle_crossing(a[k], a[(k + 1) % 3], b).is_some()
+                    || segment_triangle_crossing(b[k], b[(k + 1) % 3], a).is_some()
+            });
+            let mut slow = exhaustive(a, b);
+            if !crossing {
+                let features = (0..3)
+                    .flat_map(|k| {
+                        [
+                            a[k].distance(closest_point_triangle(a[k], b[0], b[1], b[2])),
+                            b[k].distance(closest_point_triangle(b[k], a[0], a[1], a[2])),
+                        ]
+                    })
+                    .chain((0..9).map(|m| {
+                        let (i, j) = (m / 3, m % 3);
+                        let (p, q) = closest_points_segment_segment(
+                            a[i],
+                            a[(i + 1) % 3],
+                            b[j],
+                            b[(j + 1) % 3],
+                        );
+                        p.distance(q)
+                    }))
+                    .fold(f32::INFINITY, f32::min);
+                slow.distance = features;
+            }
+            let tol = 1e-5 * (1.0 + slow.distance);
+            assert!(
+                (fast.distance - slow.distance).abs() <= tol,
+                "{a:?} {b:?}: {fast:?} vs {slow:?}"
+            );
+            // The points are on their triangles and as far apart as reported.
+            assert!((fast.on_first.distance(fast.on_second) - fast.distance).abs() <= tol);
+            for (p, t) in [(fast.on_first, a), (fast.on_second, b)] {
+                let q = closest_point_triangle(p, t[0], t[1], t[2]);
+                assert!(q.distance(p) <= 1e-5, "{p} off {t:?}");
+            }
+            by_kind[if slow.distance == 0.0 {
+                0
+            } else if slow.distance < 0.05 {
+                1
+            } else {
+                2
+            }] += 1;
+        }
     }
 
     #[test]

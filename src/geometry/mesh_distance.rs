@@ -14,7 +14,9 @@ use glam::{Mat3, Vec3};
 use super::{
     aabb::Aabb,
     bvh::TriangleBvh,
-    closest::{TrianglePair, closest_point_triangle, closest_points_triangle_triangle},
+    closest::{
+        TrianglePair, closest_point_triangle, closest_points_triangle_triangle, triangle_plane_gap,
+    },
     pose::Pose,
     trimesh::TriMesh,
 };
@@ -95,6 +97,12 @@ pub fn closest_triangles(
                 let ta = a.mesh.triangle(i as usize);
                 for &j in b.bvh.leaf_triangles(&node_b) {
                     let tb = b.mesh.triangle(j as usize).map(|v| rel.transform_point(v));
+                    if best.is_some() {
+                        let lb = triangle_plane_gap(&ta, &tb);
+                        if lb * lb > best_d2 {
+                            continue;
+                        }
+                    }
                     let pair = closest_points_triangle_triangle(&ta, &tb);
                     let pd2 = pair.distance * pair.distance;
                     if pd2 < best_d2 || best.is_none() && pd2 <= best_d2 {

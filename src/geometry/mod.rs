@@ -20,7 +20,7 @@ pub use aabb::Aabb;
 pub use bvh::TriangleBvh;
 pub use closest::{
     TrianglePair, closest_point_triangle, closest_points_segment_segment,
-    closest_points_triangle_triangle, triangles_intersect,
+    closest_points_triangle_triangle, triangle_plane_gap, triangles_intersect,
 };
 pub use columns::Columns;
 pub use mass::MassProperties;

@@ -24,11 +24,17 @@
 //!
 //! [`Motion::arc_factor`]: crate::collision::motion::Motion::arc_factor
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
-use super::{Body, PairContact};
+use super::{
+    Body, PairContact,
+    lanes::{Affine32, SweptChunk, bits, f32_slack, swept_mask},
+};
 use crate::{
-    collision::motion::{DPose, NodeCache},
+    collision::{
+        motion::{DPose, NodeCache},
+        shape::CompactTree,
+    },
     geometry::interval::Interval,
 };
 
@@ -124,6 +130,11 @@ pub fn first_contact(a: DVec3, b: DVec3, r: f64) -> Option<f64> {
 /// Calls `leaf(i, j, t)` for every leaf pair whose swept (inflated) spheres meet during the step;
 /// with `earliest_only`, node pairs that cannot meet before the earliest leaf time found so far are
 /// skipped (the earliest time is still exact; later pairs may be left out).
+///
+/// Centres are mapped in f32 relative to the first tooth's start position, a group of siblings at
+/// a time and once per query ([`super::lanes`]); the interval test runs on whole groups, and the
+/// time (Eq. 2, in f64) only for the lanes that pass it. The contact distance carries the f32
+/// slack of [`f32_slack`], so the time stays conservative for the real motion.
 pub fn swept_leaves(
     a: &Body,
     b: &Body,
@@ -131,123 +142,166 @@ pub fn swept_leaves(
     mut leaf: impl FnMut(usize, usize, f64),
 ) {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
-    let (a0, a1) = (
-        DPose::from_pose(&a.motion.start),
-        DPose::from_pose(&a.motion.end),
-    );
-    let (b0, b1) = (
-        DPose::from_pose(&b.motion.start),
-        DPose::from_pose(&b.motion.end),
-    );
-    let (ka, kb) = (a.motion.arc_factor(), b.motion.arc_factor());
-    // Slack for the rounding of transformed centres: far above f64's error at these coordinates.
-    let scale = [a.motion.start, a.motion.end, b.motion.start, b.motion.end]
-        .iter()
-        .map(|p| p.translation.abs().max_element() as f64)
-        .fold(0.0, f64::max)
-        + a.shape.max_rho as f64
-        + b.shape.max_rho as f64
-        + 100.0;
-    let slack = rounding_slack(scale);
-    CACHE.with_borrow_mut(|(cache_a, cache_b)| {
-        cache_a.begin(ta.spheres.len());
-        cache_b.begin(tb.spheres.len());
+    if ta.is_empty() || tb.is_empty() {
+        return;
+    }
+    let origin = a.motion.start.translation.as_dvec3();
+    let map = |p: &crate::geometry::Pose| {
+        let d = DPose::from_pose(p);
+        Affine32::new(d.rotation, d.translation - origin)
+    };
+    let maps = [
+        map(&a.motion.start),
+        map(&a.motion.end),
+        map(&b.motion.start),
+        map(&b.motion.end),
+    ];
+    // Arc–chord factors rounded up to f32.
+    let up = |k: f64| (k as f32).next_up() * super::lanes::GROW;
+    let k = [up(a.motion.arc_factor()), up(b.motion.arc_factor())];
+    let reach = maps.iter().map(Affine32::reach).fold(0.0, f32::max);
+    let slack = f32_slack(reach + ta.max_rho + tb.max_rho);
+    CACHE.with_borrow_mut(|scratch| {
+        let (cache_a, cache_b, stack) = scratch;
+        cache_a.begin(ta.chunks.len());
+        cache_b.begin(tb.chunks.len());
+        stack.clear();
         descend(
-            DescentInput {
-                a,
-                b,
-                poses: [a0, a1, b0, b1],
-                k: [ka, kb],
+            Descent {
+                ta,
+                tb,
+                maps,
+                k,
                 slack,
                 earliest_only,
             },
             cache_a,
             cache_b,
+            stack,
             &mut leaf,
         );
     });
 }
 
-thread_local! {
-    static CACHE: std::cell::RefCell<(EndCache, EndCache)> =
-        const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new())) };
+/// A node pair on the descent stack: nodes, first time, and each node's start and end centre
+/// and inflated radius.
+#[derive(Clone, Copy)]
+struct Item {
+    i: u32,
+    j: u32,
+    t: f64,
+    a: (Vec3, Vec3, f32),
+    b: (Vec3, Vec3, f32),
 }
 
-/// Each node's start and end centre (world), per query.
-type EndCache = NodeCache<[DVec3; 2]>;
+type Scratch = (NodeCache<SweptChunk>, NodeCache<SweptChunk>, Vec<Item>);
 
-struct DescentInput<'q, 'a> {
-    a: &'q Body<'a>,
-    b: &'q Body<'a>,
-    poses: [DPose; 4],
-    k: [f64; 2],
-    slack: f64,
+thread_local! {
+    static CACHE: std::cell::RefCell<Scratch> =
+        const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new(), Vec::new())) };
+}
+
+struct Descent<'q> {
+    ta: &'q CompactTree,
+    tb: &'q CompactTree,
+    maps: [Affine32; 4],
+    k: [f32; 2],
+    slack: f32,
     earliest_only: bool,
 }
 
+/// The first time (Eq. 2) of a node pair that passed the interval test, from f32 centres: the
+/// contact distance carries the slack and the growth of [`super::lanes`], so the time is not
+/// after the real one.
+#[inline]
+fn pair_time(a: (Vec3, Vec3, f32), b: (Vec3, Vec3, f32), slack: f32) -> Option<f64> {
+    let start = a.0.as_dvec3() - b.0.as_dvec3();
+    let change = (a.1.as_dvec3() - b.1.as_dvec3()) - start;
+    let r = (a.2 as f64 + b.2 as f64 + slack as f64) * super::lanes::GROW as f64;
+    first_contact(start, change, r)
+}
+
 fn descend(
-    q: DescentInput,
-    cache_a: &mut EndCache,
-    cache_b: &mut EndCache,
+    q: Descent,
+    cache_a: &mut NodeCache<SweptChunk>,
+    cache_b: &mut NodeCache<SweptChunk>,
+    stack: &mut Vec<Item>,
     leaf: &mut impl FnMut(usize, usize, f64),
 ) {
-    let (ta, tb) = (&*q.a.shape.tree, &*q.b.shape.tree);
-    let [a0, a1, b0, b1] = q.poses;
-    let [ka, kb] = q.k;
-    let (slack, earliest_only) = (q.slack, q.earliest_only);
+    let Descent {
+        ta,
+        tb,
+        maps: [a0, a1, b0, b1],
+        k: [ka, kb],
+        slack,
+        earliest_only,
+    } = q;
     let mut best = f64::INFINITY;
-    // The node pair's first time (inflated spheres, linear centres), or None if they cannot meet
-    // during the step; it bounds the times of every pair of their descendants from below.
-    let mut time = |i: usize, j: usize| {
-        let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let [ca0, ca1] = cache_a.get(i, || [a0.apply(sa.centre), a1.apply(sa.centre)]);
-        let [cb0, cb1] = cache_b.get(j, || [b0.apply(sb.centre), b1.apply(sb.centre)]);
-        let start = ca0 - cb0;
-        let change = (ca1 - cb1) - start;
-        let r = sa.radius as f64
-            + sb.radius as f64
-            + ka * ta.rho[i] as f64
-            + kb * tb.rho[j] as f64
-            + slack;
-        // The interval test, then Eq. 2 itself (which already answers "not in [0, 1)").
-        if !interval_may_meet(start, change, r) {
-            return None;
-        }
-        first_contact(start, change, r)
-    };
+    let root_a = cache_a.get(0, || SweptChunk::new(&ta.chunks[0], &a0, &a1, ka));
+    let root_b = cache_b.get(0, || SweptChunk::new(&tb.chunks[0], &b0, &b1, kb));
+    let (ra, rb) = (root_a.lane(0), root_b.lane(0));
+    if swept_mask(&root_a, rb.0, rb.1, rb.2, slack, 1) != 0
+        && let Some(t) = pair_time(ra, rb, slack)
+    {
+        stack.push(Item {
+            i: 0,
+            j: 0,
+            t,
+            a: ra,
+            b: rb,
+        });
+    }
     // Depth first, the children of a pair visited earliest first, so that with `earliest_only`
     // a good bound is found early and later subtrees are cut.
-    let mut stack: Vec<(u32, u32, f64)> = Vec::with_capacity(64);
-    if let Some(t) = time(0, 0) {
-        stack.push((0, 0, t));
-    }
-    while let Some((i, j, t)) = stack.pop() {
-        if earliest_only && t >= best {
+    while let Some(it) = stack.pop() {
+        if earliest_only && it.t >= best {
             continue;
         }
-        let (i, j) = (i as usize, j as usize);
+        let (i, j) = (it.i as usize, it.j as usize);
         let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
         if la && lb {
-            best = best.min(t);
-            leaf(i, j, t);
+            best = best.min(it.t);
+            leaf(i, j, it.t);
             continue;
         }
         let first = stack.len();
         if !la && (lb || ta.spheres[i].radius >= tb.spheres[j].radius) {
-            for c in ta.children(i) {
-                if let Some(t) = time(c, j) {
-                    stack.push((c as u32, j as u32, t));
+            for c in ta.child_chunks[i].clone() {
+                let ch = &ta.chunks[c as usize];
+                let sw = cache_a.get_ref(c as usize, || SweptChunk::new(ch, &a0, &a1, ka));
+                let (b_start, b_end, b_r) = it.b;
+                for l in bits(swept_mask(sw, b_start, b_end, b_r, slack, ch.used())) {
+                    let a = sw.lane(l);
+                    if let Some(t) = pair_time(a, it.b, slack) {
+                        stack.push(Item {
+                            i: ch.node[l],
+                            t,
+                            a,
+                            ..it
+                        });
+                    }
                 }
             }
         } else {
-            for c in tb.children(j) {
-                if let Some(t) = time(i, c) {
-                    stack.push((i as u32, c as u32, t));
+            for c in tb.child_chunks[j].clone() {
+                let ch = &tb.chunks[c as usize];
+                let sw = cache_b.get_ref(c as usize, || SweptChunk::new(ch, &b0, &b1, kb));
+                let (a_start, a_end, a_r) = it.a;
+                for l in bits(swept_mask(sw, a_start, a_end, a_r, slack, ch.used())) {
+                    let b = sw.lane(l);
+                    if let Some(t) = pair_time(it.a, b, slack) {
+                        stack.push(Item {
+                            j: ch.node[l],
+                            t,
+                            b,
+                            ..it
+                        });
+                    }
                 }
             }
         }
         if earliest_only {
-            stack[first..].sort_unstable_by(|x, y| y.2.total_cmp(&x.2));
+            stack[first..].sort_unstable_by(|x, y| y.t.total_cmp(&x.t));
         }
     }
 }

@@ -8,7 +8,8 @@
 //!
 //! Windows: the search starts at the earliest leaf time (no contact can happen before it). When no
 //! point moves more than 1 mm in the rest of the step (short steps near contact) the rest is
-//! searched at once; otherwise in windows of doubling length (1/32 of the step first), each with
+//! searched at once, with the leaf pairs of one continuous query over the whole step; otherwise
+//! in windows of doubling length (1/32 of the step first), each with
 //! only the leaf pairs whose swept spheres meet within it, so a long step does not drag every leaf
 //! pair of its whole sweep into the triangle stage.
 //!
@@ -16,23 +17,26 @@
 //! the distance between the contact-capable parts (the surface inside each meeting leaf pair) is
 //! computed at the current poses: the exact distance between candidate triangles, visiting leaf
 //! pairs nearest first and skipping a leaf pair once its spheres are farther apart than the best
-//! distance so far (its in-sphere surface cannot be closer); no point of the candidates
+//! distance so far (its in-sphere surface cannot be closer), and measuring a triangle pair only
+//! when neither the triangles' bounding spheres nor their planes (one triangle wholly beyond the
+//! other's plane, a lower bound that is nearly exact for the facing triangles of teeth in contact)
+//! already show it farther than the best; no point of the candidates
 //! moves faster than μ = Σ (origin travel + rotation angle × farthest candidate vertex from the
 //! origin) per unit time ([`Motion::speed_bound`]), so the gap cannot close before t + d/μ. Each
 //! step advances by (d − tolerance/2)/μ, leaving at least half the tolerance, and stops when
 //! d ≤ [`GAP_TOLERANCE_MM`]: the reported time is never after the first contact and the gap left
 //! there is within the tolerance. Between steps each triangle pair keeps its last distance: it
 //! cannot have shrunk by more than μ·Δt, so pairs whose carried bound exceeds the best distance of
-//! the step are not measured again (the minimum is unchanged, only cheaper). Teeth already interpenetrating at t = 0 report time 0 and the
-//! penetration depth of the whole meshes. After [`MAX_STEPS`] steps (slow convergence under large
+//! the step are not measured again (the minimum is unchanged, only cheaper). Teeth already
+//! interpenetrating at t = 0 report time 0 and the penetration depth of the whole meshes. After [`MAX_STEPS`] steps (slow convergence under large
 //! rotations) the current, still conservative, time is reported with its gap.
 //!
 //! [`Motion::speed_bound`]: crate::collision::motion::Motion::speed_bound
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{Body, PairContact, continuous};
-use crate::collision::motion::Motion;
+use crate::collision::motion::{Motion, NodeCache};
 use crate::geometry::{MeshRef, closest_points_triangle_triangle, mesh_separation};
 
 /// Largest gap left between teeth reported as touching (mm).
@@ -46,15 +50,75 @@ pub const MAX_STEPS: u32 = 1000;
 /// measured at, far above either, when it is carried forward as a bound.
 const LIPSCHITZ_SLACK_MM: f64 = 1e-4;
 
-/// A meeting leaf pair (nodes of a and b) with its candidate triangle pairs.
-type LeafPair = (u32, u32, Vec<(u32, u32)>);
+/// One candidate triangle placed at the current time: vertices, bounding sphere, and unit normal
+/// with its plane offset (zero normal for needles, whose normal is not trusted).
+#[derive(Clone, Copy, Default)]
+struct PlacedTri {
+    v: [Vec3; 3],
+    centre: Vec3,
+    radius: f32,
+    normal: DVec3,
+    offset: f64,
+}
+
+impl PlacedTri {
+    fn new(v: [Vec3; 3]) -> Self {
+        let centre = (v[0] + v[1] + v[2]) / 3.0;
+        let radius = v.iter().map(|p| p.distance(centre)).fold(0.0f32, f32::max);
+        let p0 = v[0].as_dvec3();
+        let (e1, e2) = (v[1].as_dvec3() - p0, v[2].as_dvec3() - p0);
+        let n = e1.cross(e2);
+        let len2 = n.length_squared();
+        // Needles (sine below 10⁻⁶) get no plane.
+        let normal = if len2 > 1e-12 * e1.length_squared() * e2.length_squared() && len2 > 0.0 {
+            n / len2.sqrt()
+        } else {
+            DVec3::ZERO
+        };
+        Self {
+            v,
+            centre,
+            radius,
+            normal,
+            offset: normal.dot(p0),
+        }
+    }
+
+    /// How far all of `o` lies beyond this triangle's plane, on either side (0 if it straddles).
+    #[inline]
+    fn beyond(&self, o: &[Vec3; 3]) -> f64 {
+        let s = o.map(|p| self.normal.dot(p.as_dvec3()) - self.offset);
+        if s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0 {
+            s[0].min(s[1]).min(s[2])
+        } else if s[0] < 0.0 && s[1] < 0.0 && s[2] < 0.0 {
+            -(s[0].max(s[1]).max(s[2]))
+        } else {
+            0.0
+        }
+    }
+
+    /// A lower bound of the distance to `o` ([`crate::geometry::triangle_plane_gap`] with the
+    /// planes computed once per step). The unit normal's direction is within 10⁻⁹ (sine ≥ 10⁻⁶,
+    /// f64) and each signed distance within a few ulps of the coordinates; the margin covers
+    /// both with room to spare.
+    #[inline]
+    fn gap_to(&self, o: &PlacedTri) -> f32 {
+        let m = self.beyond(&o.v).max(o.beyond(&self.v));
+        if m <= 0.0 {
+            return 0.0;
+        }
+        let near = (self.centre.distance(o.centre) + self.radius + o.radius) as f64;
+        let far = (self.centre.length() + o.centre.length()) as f64 + near;
+        let margin = 1e-8 * near + 1e-14 * far;
+        ((m - margin).max(0.0) as f32) * (1.0 - 1e-6)
+    }
+}
 
 /// Triangles of one side placed at the current time, on demand.
 struct Placed<'m> {
     mesh: &'m crate::geometry::TriMesh,
     ids: Vec<u32>,
-    tris: Vec<[Vec3; 3]>,
-    bound: Vec<(Vec3, f32)>,
+    tris: Vec<PlacedTri>,
     stamp: Vec<u32>,
     now: u32,
 }
@@ -65,27 +129,58 @@ impl<'m> Placed<'m> {
         Self {
             mesh,
             ids,
-            tris: vec![[Vec3::ZERO; 3]; n],
-            bound: vec![(Vec3::ZERO, 0.0); n],
+            tris: vec![PlacedTri::default(); n],
             stamp: vec![0; n],
             now: 0,
         }
     }
 
-    fn get(&mut self, k: usize, pose: &crate::geometry::Pose) -> (&[Vec3; 3], (Vec3, f32)) {
+    #[inline]
+    fn get(&mut self, k: usize, pose: &crate::geometry::Pose) -> &PlacedTri {
         if self.stamp[k] != self.now {
             let tri = self
                 .mesh
                 .triangle(self.ids[k] as usize)
                 .map(|v| pose.transform_point(v));
-            let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-            let r = tri.iter().map(|v| v.distance(c)).fold(0.0f32, f32::max);
-            self.tris[k] = tri;
-            self.bound[k] = (c, r);
+            self.tris[k] = PlacedTri::new(tri);
             self.stamp[k] = self.now;
         }
-        (&self.tris[k], self.bound[k])
+        &self.tris[k]
     }
+}
+
+/// Per-thread scratch of the advancement: each mesh triangle's index among the candidates, and
+/// per candidate triangle pair its carried bound (see [`advance`]).
+struct Scratch {
+    slot_a: NodeCache<u32>,
+    slot_b: NodeCache<u32>,
+    seen: Vec<Seen>,
+    generation: u32,
+}
+
+/// A candidate triangle pair's record: the query (generation) and step it was last looked at,
+/// and its last measured distance (or lower bound) with the time of it.
+#[derive(Clone, Copy, Default)]
+struct Seen {
+    generation: u32,
+    step: u32,
+    d: f32,
+    t: f64,
+}
+
+/// Candidate pair tables up to this many entries are kept per thread between queries; larger
+/// ones (scan-resolution teeth in deep contact) are allocated for the query.
+const KEEP_SEEN: usize = 1 << 18;
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = const {
+        std::cell::RefCell::new(Scratch {
+            slot_a: NodeCache::new(),
+            slot_b: NodeCache::new(),
+            seen: Vec::new(),
+            generation: 0,
+        })
+    };
 }
 
 /// The exact query.
@@ -93,17 +188,21 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
     // The earliest leaf time bounds the first contact from below; from there the step is searched
     // in windows of growing length, each with only the leaf pairs that meet within it (a slerp and
     // lerp restricted to a sub-interval is the slerp and lerp between its end poses).
+    // Short steps (no point moves more than WHOLE_STEP_TRAVEL_MM): the whole step at once,
+    // from the earliest leaf time; longer ones in doubling windows from there.
+    let whole =
+        a.motion.speed_bound(a.shape.max_rho as f64) + b.motion.speed_bound(b.shape.max_rho as f64);
+    if whole <= WHOLE_STEP_TRAVEL_MM {
+        let swept = continuous::query(a, b, true)?;
+        return advance(a, b, &swept);
+    }
     let first = continuous::query(a, b, false)?;
     let mut t = first
         .leaf_times
         .iter()
         .map(|x| x.2)
         .fold(f64::INFINITY, f64::min);
-    // Short steps (no point moves more than WHOLE_STEP_TRAVEL_MM in the rest of the step): the
-    // rest at once; longer ones in doubling windows.
-    let travel = (a.motion.speed_bound(a.shape.max_rho as f64)
-        + b.motion.speed_bound(b.shape.max_rho as f64))
-        * (1.0 - t);
+    let travel = whole * (1.0 - t);
     let mut window = if travel <= WHOLE_STEP_TRAVEL_MM {
         1.0 - t
     } else {
@@ -142,34 +241,51 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
 /// Conservative advancement over the bodies' whole motion, from the earliest meeting leaf time of
 /// `swept` (which must list every meeting leaf pair).
 fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairContact> {
+    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, scratch))
+}
+
+fn advance_with(
+    a: &Body,
+    b: &Body,
+    swept: &continuous::SweptContact,
+    scratch: &mut Scratch,
+) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
-    // Candidate triangles of each side and candidate pairs (as indices into them).
+    let (ma, mb) = (&a.shape.geometry.mesh, &b.shape.geometry.mesh);
+    // Candidate triangles of each side (ids_a / ids_b) and, per leaf pair, its triangle pairs
+    // as indices into them (a flat list with one range per leaf pair).
+    let Scratch {
+        slot_a,
+        slot_b,
+        seen,
+        generation,
+    } = scratch;
+    slot_a.begin(ma.triangles.len());
+    slot_b.begin(mb.triangles.len());
     let mut ids_a: Vec<u32> = Vec::new();
     let mut ids_b: Vec<u32> = Vec::new();
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let mut leaf_pairs: Vec<(u32, u32, std::ops::Range<usize>)> =
+        Vec::with_capacity(swept.leaf_times.len());
+    let mut local_b: Vec<u32> = Vec::new();
     for &(i, j, _) in &swept.leaf_times {
-        ids_a.extend_from_slice(&ta.triangles[i as usize]);
-        ids_b.extend_from_slice(&tb.triangles[j as usize]);
+        local_b.clear();
+        for &y in &tb.triangles[j as usize] {
+            local_b.push(slot_b.get(y as usize, || {
+                ids_b.push(y);
+                ids_b.len() as u32 - 1
+            }));
+        }
+        let first = pairs.len();
+        for &x in &ta.triangles[i as usize] {
+            let xi = slot_a.get(x as usize, || {
+                ids_a.push(x);
+                ids_a.len() as u32 - 1
+            });
+            pairs.extend(local_b.iter().map(|&yi| (xi, yi)));
+        }
+        leaf_pairs.push((i, j, first..pairs.len()));
     }
-    ids_a.sort_unstable();
-    ids_a.dedup();
-    ids_b.sort_unstable();
-    ids_b.dedup();
-    // Per leaf pair, its triangle pairs (indices into ids_a / ids_b).
-    let leaf_pairs: Vec<LeafPair> = swept
-        .leaf_times
-        .iter()
-        .map(|&(i, j, _)| {
-            let mut tp = Vec::new();
-            for &x in &ta.triangles[i as usize] {
-                let xi = ids_a.binary_search(&x).expect("collected above") as u32;
-                for &y in &tb.triangles[j as usize] {
-                    tp.push((xi, ids_b.binary_search(&y).expect("collected above") as u32));
-                }
-            }
-            (i, j, tp)
-        })
-        .collect();
-    let (ma, mb) = (&a.shape.geometry.mesh, &b.shape.geometry.mesh);
     let rho = |mesh: &crate::geometry::TriMesh, ids: &[u32]| {
         ids.iter()
             .flat_map(|&t| mesh.triangle(t as usize))
@@ -184,14 +300,32 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
         .iter()
         .map(|x| x.2)
         .fold(f64::INFINITY, f64::min);
+    let ny = ids_b.len();
+    let table = ids_a.len() * ny;
     let mut pa = Placed::new(ma, ids_a);
     let mut pb = Placed::new(mb, ids_b);
     let mut order: Vec<(f32, usize)> = Vec::with_capacity(leaf_pairs.len());
-    let ny = pb.ids.len();
-    // Per triangle pair: the step it was last looked at (leaf pairs share triangles), and its
-    // last measured distance with the time of it: no pair's distance shrinks faster than μ, so
-    // d − μ·(t − t_then) bounds it now and pairs that cannot beat the best are skipped.
-    let mut seen = vec![(0u32, f32::INFINITY, 0.0f64); pa.ids.len() * ny];
+    // Per triangle pair (leaf pairs share triangles): the step it was last looked at, and its
+    // last measured distance (or lower bound) with the time of it: no pair's distance shrinks
+    // faster than μ, so d − μ·(t − t_then) bounds it now and pairs that cannot beat the best
+    // are skipped. Small tables live on in the thread's scratch, told apart by generation.
+    let mut own: Vec<Seen>;
+    let seen: &mut [Seen] = if table <= KEEP_SEEN {
+        if seen.len() < table {
+            seen.resize(table, Seen::default());
+        }
+        *generation = generation.wrapping_add(1);
+        if *generation == 0 {
+            seen.iter_mut().for_each(|s| s.generation = 0);
+            *generation = 1;
+        }
+        &mut seen[..table]
+    } else {
+        *generation = generation.wrapping_add(1).max(1);
+        own = vec![Seen::default(); table];
+        &mut own
+    };
+    let now = *generation;
     let mut step = 0u32;
     for round in 0..=MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
@@ -209,33 +343,46 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairC
                 - sb.radius;
             order.push((gap, k));
         }
-        order.sort_by(|x, y| x.0.total_cmp(&y.0));
+        order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         step += 1;
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
         for &(gap, k) in &order {
             if gap >= best.0 {
                 break;
             }
-            for &(x, y) in &leaf_pairs[k].2 {
+            for &(x, y) in &pairs[leaf_pairs[k].2.clone()] {
                 let key = x as usize * ny + y as usize;
-                let (last_step, then_d, then_t) = seen[key];
-                if last_step == step {
+                let record = &mut seen[key];
+                if record.generation == now {
+                    if record.step == step {
+                        continue;
+                    }
+                    if record.d as f64 - mu * (t - record.t) - LIPSCHITZ_SLACK_MM >= best.0 as f64 {
+                        record.step = step;
+                        continue;
+                    }
+                }
+                *record = Seen {
+                    generation: now,
+                    step,
+                    d: f32::INFINITY,
+                    t,
+                };
+                let tx = *pa.get(x as usize, &pose_a);
+                let ty = pb.get(y as usize, &pose_b);
+                let spheres = tx.centre.distance(ty.centre) - tx.radius - ty.radius;
+                if spheres >= best.0 {
+                    record.d = spheres.max(0.0);
                     continue;
                 }
-                seen[key].0 = step;
-                if then_d.is_finite()
-                    && then_d as f64 - mu * (t - then_t) - LIPSCHITZ_SLACK_MM >= best.0 as f64
-                {
+                // Facing triangles: the plane gap is nearly the distance and far cheaper.
+                let lb = tx.gap_to(ty);
+                if lb >= best.0 {
+                    record.d = lb;
                     continue;
                 }
-                let (tx, (cx, rx)) = pa.get(x as usize, &pose_a);
-                let tx = *tx;
-                let (ty, (cy, ry)) = pb.get(y as usize, &pose_b);
-                if cx.distance(cy) - rx - ry >= best.0 {
-                    continue;
-                }
-                let p = closest_points_triangle_triangle(&tx, ty);
-                seen[key] = (step, p.distance, t);
+                let p = closest_points_triangle_triangle(&tx.v, &ty.v);
+                record.d = p.distance;
                 if p.distance < best.0 {
                     best = (p.distance, p.on_first, p.on_second);
                 }

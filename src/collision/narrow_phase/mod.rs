@@ -13,6 +13,7 @@
 pub mod circles;
 pub mod continuous;
 pub mod exact;
+pub mod lanes;
 pub mod spheres;
 
 use glam::Vec3;

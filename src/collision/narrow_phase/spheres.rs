@@ -1,64 +1,179 @@
 //! Discrete sphere trees: simultaneous descent of both trees at the end pose, collecting every
 //! overlapping leaf pair. Conservative at that pose: surfaces that touch lie in overlapping leaves
-//! (the coverage invariant), and node tests are in f64 with a relative slack of 10⁻¹².
+//! (the coverage invariant), and node tests allow for rounding (see [`super::lanes`]).
+//!
+//! The descent runs in the first tooth's local frame: its spheres are used as stored and only the
+//! second tooth's are mapped, a group of siblings at a time and once per query.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
-use super::{Body, PairContact};
+use super::{
+    Body, PairContact,
+    lanes::{Affine32, bits, f32_slack, overlap_mask},
+};
 use crate::collision::{
     motion::{DPose, NodeCache},
-    shape::CompactTree,
+    shape::{CompactTree, LANES},
 };
 
-/// Calls `leaf(i, j, ca, cb)` for every overlapping leaf pair of the two trees at the given poses.
+/// A node pair on the descent stack: nodes, centres (first tooth's frame) and radii.
+#[derive(Clone, Copy)]
+struct Item {
+    i: u32,
+    j: u32,
+    leaf_a: bool,
+    leaf_b: bool,
+    a: Vec3,
+    ra: f32,
+    b: Vec3,
+    rb: f32,
+}
+
+/// Calls `leaf(i, j, depth)` for every overlapping leaf pair of the two trees at the given poses,
+/// with the pair's overlap (sum of radii minus centre distance; negative within the slack).
 pub fn overlapping_leaves(
     ta: &CompactTree,
     pa: &DPose,
     tb: &CompactTree,
     pb: &DPose,
-    mut leaf: impl FnMut(usize, usize, DVec3, DVec3),
+    mut leaf: impl FnMut(usize, usize, f32),
 ) {
-    CACHE.with_borrow_mut(|(cache_a, cache_b)| {
-        cache_a.begin(ta.spheres.len());
-        cache_b.begin(tb.spheres.len());
-        descend(ta, pa, tb, pb, cache_a, cache_b, &mut leaf);
+    if ta.is_empty() || tb.is_empty() {
+        return;
+    }
+    // b in a's frame: pa⁻¹ ∘ pb.
+    let inv = pa.rotation.inverse();
+    let rel = Affine32::new(inv * pb.rotation, inv * (pb.translation - pa.translation));
+    let slack = f32_slack(ta.max_rho + tb.max_rho + rel.reach());
+    CACHE.with_borrow_mut(|(cache, stack)| {
+        cache.begin(tb.chunks.len());
+        stack.clear();
+        let root_b = cache.get_ref(0, || rel.apply_chunk(&tb.chunks[0]));
+        let (sa, sb) = (&ta.spheres[0], &tb.spheres[0]);
+        let b = Vec3::new(root_b[0][0], root_b[1][0], root_b[2][0]);
+        let a_root = [
+            [sa.centre.x; LANES],
+            [sa.centre.y; LANES],
+            [sa.centre.z; LANES],
+        ];
+        // Leaf pairs are reported as they are found; only pairs with an inner node are stacked.
+        let mut emit = |it: Item, stack: &mut Vec<Item>| {
+            if it.leaf_a && it.leaf_b {
+                leaf(
+                    it.i as usize,
+                    it.j as usize,
+                    it.ra + it.rb - it.a.distance(it.b),
+                );
+            } else {
+                stack.push(it);
+            }
+        };
+        if overlap_mask(xyz3(&a_root), &[sa.radius; LANES], b, sb.radius, slack, 1) != 0 {
+            emit(
+                Item {
+                    i: 0,
+                    j: 0,
+                    leaf_a: ta.is_leaf(0),
+                    leaf_b: tb.is_leaf(0),
+                    a: sa.centre,
+                    ra: sa.radius,
+                    b,
+                    rb: sb.radius,
+                },
+                stack,
+            );
+        }
+        while let Some(it) = stack.pop() {
+            let (i, j) = (it.i as usize, it.j as usize);
+            let (la, lb) = (it.leaf_a, it.leaf_b);
+            if la {
+                // Split b.
+                for c in tb.child_chunks[j].clone() {
+                    let ch = &tb.chunks[c as usize];
+                    let xyz = cache.get_ref(c as usize, || rel.apply_chunk(ch));
+                    for k in bits(overlap_mask(
+                        xyz3(xyz),
+                        &ch.r,
+                        it.a,
+                        it.ra,
+                        slack,
+                        ch.used(),
+                    )) {
+                        let b = Vec3::new(xyz[0][k], xyz[1][k], xyz[2][k]);
+                        let leaf_b = ch.leaves >> k & 1 != 0;
+                        emit(
+                            Item {
+                                j: ch.node[k],
+                                b,
+                                rb: ch.r[k],
+                                leaf_b,
+                                ..it
+                            },
+                            stack,
+                        );
+                    }
+                }
+                continue;
+            }
+            // Split a; when b is inner too, split b under each of a's children that meets it.
+            for c in ta.child_chunks[i].clone() {
+                let ch = &ta.chunks[c as usize];
+                let xyz = [&ch.x, &ch.y, &ch.z];
+                for k in bits(overlap_mask(xyz, &ch.r, it.b, it.rb, slack, ch.used())) {
+                    let a = Vec3::new(ch.x[k], ch.y[k], ch.z[k]);
+                    let leaf_a = ch.leaves >> k & 1 != 0;
+                    let child = Item {
+                        i: ch.node[k],
+                        a,
+                        ra: ch.r[k],
+                        leaf_a,
+                        ..it
+                    };
+                    if lb {
+                        emit(child, stack);
+                        continue;
+                    }
+                    for d in tb.child_chunks[j].clone() {
+                        let dh = &tb.chunks[d as usize];
+                        let xyz = cache.get_ref(d as usize, || rel.apply_chunk(dh));
+                        for l in bits(overlap_mask(
+                            xyz3(xyz),
+                            &dh.r,
+                            a,
+                            child.ra,
+                            slack,
+                            dh.used(),
+                        )) {
+                            let b = Vec3::new(xyz[0][l], xyz[1][l], xyz[2][l]);
+                            let leaf_b = dh.leaves >> l & 1 != 0;
+                            emit(
+                                Item {
+                                    j: dh.node[l],
+                                    b,
+                                    rb: dh.r[l],
+                                    leaf_b,
+                                    ..child
+                                },
+                                stack,
+                            );
+                        }
+                    }
+                }
+            }
+        }
     });
 }
 
-thread_local! {
-    static CACHE: std::cell::RefCell<(NodeCache<DVec3>, NodeCache<DVec3>)> =
-        const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new())) };
+#[inline]
+fn xyz3(v: &[[f32; LANES]; 3]) -> [&[f32; LANES]; 3] {
+    [&v[0], &v[1], &v[2]]
 }
 
-fn descend(
-    ta: &CompactTree,
-    pa: &DPose,
-    tb: &CompactTree,
-    pb: &DPose,
-    cache_a: &mut NodeCache<DVec3>,
-    cache_b: &mut NodeCache<DVec3>,
-    leaf: &mut impl FnMut(usize, usize, DVec3, DVec3),
-) {
-    let mut stack: Vec<(u32, u32)> = Vec::with_capacity(64);
-    stack.push((0, 0));
-    while let Some((i, j)) = stack.pop() {
-        let (i, j) = (i as usize, j as usize);
-        let (sa, sb) = (&ta.spheres[i], &tb.spheres[j]);
-        let ca = cache_a.get(i, || pa.apply(sa.centre));
-        let cb = cache_b.get(j, || pb.apply(sb.centre));
-        let r = (sa.radius as f64 + sb.radius as f64) * (1.0 + 1e-12) + 1e-12;
-        if ca.distance_squared(cb) > r * r {
-            continue;
-        }
-        let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
-        if la && lb {
-            leaf(i, j, ca, cb);
-        } else if !la && (lb || sa.radius >= sb.radius) {
-            stack.extend(ta.children(i).map(|c| (c as u32, j as u32)));
-        } else {
-            stack.extend(tb.children(j).map(|c| (i as u32, c as u32)));
-        }
-    }
+type Scratch = (NodeCache<[[f32; LANES]; 3]>, Vec<Item>);
+
+thread_local! {
+    static CACHE: std::cell::RefCell<Scratch> =
+        const { std::cell::RefCell::new((NodeCache::new(), Vec::new())) };
 }
 
 /// Overlapping leaves at the end pose; the contact is reported at the deepest leaf pair.
@@ -69,16 +184,20 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
     );
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let mut pairs = Vec::new();
-    let mut deepest: Option<(f64, DVec3, DVec3, f64, f64)> = None;
-    overlapping_leaves(ta, &pa, tb, &pb, |i, j, ca, cb| {
+    let mut deepest: Option<(f32, usize, usize)> = None;
+    overlapping_leaves(ta, &pa, tb, &pb, |i, j, depth| {
         pairs.push((i as u32, j as u32));
-        let (ra, rb) = (ta.spheres[i].radius as f64, tb.spheres[j].radius as f64);
-        let depth = ra + rb - ca.distance(cb);
         if deepest.is_none_or(|d| depth > d.0) {
-            deepest = Some((depth, ca, cb, ra, rb));
+            deepest = Some((depth, i, j));
         }
     });
-    let (depth, ca, cb, ra, rb) = deepest?;
+    let (_, i, j) = deepest?;
+    let (ca, cb) = (
+        pa.apply(ta.spheres[i].centre),
+        pb.apply(tb.spheres[j].centre),
+    );
+    let (ra, rb) = (ta.spheres[i].radius as f64, tb.spheres[j].radius as f64);
+    let depth = ra + rb - ca.distance(cb);
     let n = (cb - ca).try_normalize().unwrap_or(DVec3::X);
     Some(PairContact {
         time_of_contact: 1.0,
