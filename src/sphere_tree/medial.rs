@@ -22,7 +22,8 @@
 //!    lattice of 15 points per piece: each point goes to the sphere that holds it with the most
 //!    room, each sphere shrinks to its points (radii only shrink, so the points stay covered), and
 //!    each sphere's centre is moved by a pattern search that lowers its outside volume while it
-//!    holds its points. Six rounds.
+//!    holds its points (the farthest point found over lanes of eight). One shrinking round, then
+//!    five rounds of polish and shrink.
 //! 6. **Exact cover.** Every triangle is split as the coverage check splits it until each piece
 //!    lies in one sphere (the one with the most room); a piece no sphere holds after five splits —
 //!    a sliver between the points — grows the sphere that needs the least growth. Each sphere then
@@ -52,9 +53,7 @@ use crate::geometry::{
 };
 
 /// Growth margins of the candidates, as fractions of the leaf spacing s.
-const GROWTH: [f32; 12] = [
-    0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63,
-];
+const GROWTH: [f32; 10] = [0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37];
 /// The same for budgets under 64 leaves, whose few spheres must each cover much more of the tooth.
 const GROWTH_WIDE: [f32; 16] = [
     0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63, 0.85, 1.15, 1.5, 2.0,
@@ -70,9 +69,9 @@ const MAX_SEEDS: usize = 6_000;
 /// Points per piece edge (minus one) for the shrinking rounds: a 4 × 4 lattice of points per piece.
 const POINT_LATTICE: u32 = 4;
 /// Shrinking rounds after the cover.
-const SHRINK_ROUNDS: u32 = 3;
+const SHRINK_ROUNDS: u32 = 1;
 /// Rounds of centre polishing, each followed by a shrinking round.
-const POLISH_ROUNDS: u32 = 6;
+const POLISH_ROUNDS: u32 = 5;
 /// Lattice lines across the tooth for outside volumes.
 const LINES: usize = 64;
 /// Radius rounding so that f32 containment agrees with the distances used here.
@@ -627,7 +626,6 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
         for (p, &o) in points.iter().zip(&point_owner) {
             owned[o as usize].push(*p);
         }
-        owned.iter_mut().for_each(dedup);
         for (sphere, points) in spheres.iter_mut().zip(&owned) {
             if !points.is_empty() {
                 *sphere = polish(&columns, *sphere, points);
@@ -815,12 +813,36 @@ fn dedup(points: &mut Vec<Vec3>) {
 /// pattern search (steps from a quarter of the radius down to 2 %, at most 40 trials), the radius
 /// following the farthest point.
 fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
+    // Points relative to the starting centre, in lanes of eight: the farthest point from a trial
+    // centre is a max over squared distances that the compiler vectorises.
+    let o = leaf.centre;
+    let lanes = points.len().div_ceil(8);
+    let mut xyz = vec![[[0.0f32; 8]; 3]; lanes];
+    for (k, p) in points.iter().enumerate() {
+        let d = *p - o;
+        xyz[k / 8][0][k % 8] = d.x;
+        xyz[k / 8][1][k % 8] = d.y;
+        xyz[k / 8][2][k % 8] = d.z;
+    }
+    // Padding lanes repeat the first point, which changes no maximum.
+    if let Some(first) = points.first() {
+        let d = *first - o;
+        for k in points.len()..lanes * 8 {
+            xyz[k / 8][0][k % 8] = d.x;
+            xyz[k / 8][1][k % 8] = d.y;
+            xyz[k / 8][2][k % 8] = d.z;
+        }
+    }
     let fit = |c: Vec3| {
-        let r = points
-            .iter()
-            .map(|p| p.distance_squared(c))
-            .fold(0.0f32, f32::max)
-            .sqrt();
+        let rel = c - o;
+        let mut m = [0.0f32; 8];
+        for [x, y, z] in &xyz {
+            for l in 0..8 {
+                let (dx, dy, dz) = (x[l] - rel.x, y[l] - rel.y, z[l] - rel.z);
+                m[l] = m[l].max(dx * dx + dy * dy + dz * dz);
+            }
+        }
+        let r = m.iter().copied().fold(0.0f32, f32::max).sqrt();
         let s = Sphere::new(c, padded(r));
         (columns.outside_volume(&s), s)
     };
