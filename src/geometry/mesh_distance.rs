@@ -307,9 +307,7 @@ pub fn mesh_separation(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> 
             point_b: pair.on_second,
         };
     }
-    let (da, pa, qa) = deepest_point(a, pose_a, b, pose_b);
-    let (db, pb, qb) = deepest_point(b, pose_b, a, pose_a);
-    let (penetration, point_a, point_b) = if da >= db { (da, pa, qa) } else { (db, qb, pb) };
+    let (penetration, point_a, point_b) = mesh_penetration(a, pose_a, b, pose_b);
     MeshSeparation {
         distance: 0.0,
         penetration,
@@ -324,6 +322,16 @@ pub fn mesh_separation(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> 
             pair.on_second
         },
     }
+}
+
+/// The penetration estimate of [`mesh_separation`] for meshes already known to touch or overlap:
+/// the deepest vertex or triangle centroid of either mesh inside the other, its depth, and the
+/// deepest point with the nearest point of the other's surface as (point on a, point on b), world
+/// frame. Depth 0 (and the local origins) when no sample point lies inside.
+pub fn mesh_penetration(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, Vec3, Vec3) {
+    let (da, pa, qa) = deepest_point(a, pose_a, b, pose_b);
+    let (db, pb, qb) = deepest_point(b, pose_b, a, pose_a);
+    if da >= db { (da, pa, qa) } else { (db, qb, pb) }
 }
 
 /// The deepest sample point of `a` (vertices and triangle centroids) inside `b`: its depth, the point

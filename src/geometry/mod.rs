@@ -24,7 +24,7 @@ pub use closest::{
 };
 pub use columns::Columns;
 pub use mass::MassProperties;
-pub use mesh_distance::{MeshRef, MeshSeparation, mesh_separation};
+pub use mesh_distance::{MeshRef, MeshSeparation, mesh_penetration, mesh_separation};
 pub use pose::Pose;
 pub use sphere::Sphere;
 pub use trimesh::{MeshError, TriMesh};

@@ -35,9 +35,10 @@
 
 use glam::{DVec3, Vec3};
 
+use super::lanes::Affine32;
 use super::{Body, PairContact, continuous};
-use crate::collision::motion::{Motion, NodeCache};
-use crate::geometry::{MeshRef, closest_points_triangle_triangle, mesh_separation};
+use crate::collision::motion::{DPose, Motion, NodeCache};
+use crate::geometry::{MeshRef, closest_points_triangle_triangle, mesh_penetration};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -114,7 +115,8 @@ impl PlacedTri {
     }
 }
 
-/// Triangles of one side placed at the current time, on demand.
+/// Triangles of one side placed in the first tooth's frame, on demand (the first tooth's own once,
+/// the second's once per step).
 struct Placed<'m> {
     mesh: &'m crate::geometry::TriMesh,
     ids: Vec<u32>,
@@ -131,17 +133,18 @@ impl<'m> Placed<'m> {
             ids,
             tris: vec![PlacedTri::default(); n],
             stamp: vec![0; n],
-            now: 0,
+            now: 1,
         }
     }
 
     #[inline]
-    fn get(&mut self, k: usize, pose: &crate::geometry::Pose) -> &PlacedTri {
+    fn get(&mut self, k: usize, map: Option<&Affine32>) -> &PlacedTri {
         if self.stamp[k] != self.now {
-            let tri = self
-                .mesh
-                .triangle(self.ids[k] as usize)
-                .map(|v| pose.transform_point(v));
+            let [p, q, r] = self.mesh.triangle(self.ids[k] as usize);
+            let tri = match map {
+                Some(m) => [m.apply(p), m.apply(q), m.apply(r)],
+                None => [p, q, r],
+            };
             self.tris[k] = PlacedTri::new(tri);
             self.stamp[k] = self.now;
         }
@@ -329,18 +332,17 @@ fn advance_with(
     let mut step = 0u32;
     for round in 0..=MAX_STEPS {
         let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
-        pa.now += 1;
+        // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
+        let (da, db) = (DPose::from_pose(&pose_a), DPose::from_pose(&pose_b));
+        let inv = da.rotation.inverse();
+        let rel = Affine32::new(inv * db.rotation, inv * (db.translation - da.translation));
         pb.now += 1;
         // Leaf pairs nearest first: a pair whose spheres are farther apart than the best distance
         // found cannot hold a closer contact-capable pair (see the module doc).
         order.clear();
         for (k, (i, j, _)) in leaf_pairs.iter().enumerate() {
             let (sa, sb) = (ta.spheres[*i as usize], tb.spheres[*j as usize]);
-            let gap = pose_a
-                .transform_point(sa.centre)
-                .distance(pose_b.transform_point(sb.centre))
-                - sa.radius
-                - sb.radius;
+            let gap = sa.centre.distance(rel.apply(sb.centre)) - sa.radius - sb.radius;
             order.push((gap, k));
         }
         order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
@@ -368,8 +370,8 @@ fn advance_with(
                     d: f32::INFINITY,
                     t,
                 };
-                let tx = *pa.get(x as usize, &pose_a);
-                let ty = pb.get(y as usize, &pose_b);
+                let tx = *pa.get(x as usize, None);
+                let ty = pb.get(y as usize, Some(&rel));
                 let spheres = tx.centre.distance(ty.centre) - tx.radius - ty.radius;
                 if spheres >= best.0 {
                     record.d = spheres.max(0.0);
@@ -392,6 +394,7 @@ fn advance_with(
         if !d.is_finite() {
             return None;
         }
+        let (qa, qb) = (pose_a.transform_point(qa), pose_a.transform_point(qb));
         let d = d as f64;
         // Within the tolerance, or out of steps: report here (still never after the contact).
         if d <= tol || round == MAX_STEPS {
@@ -404,7 +407,8 @@ fn advance_with(
             };
             if d == 0.0 {
                 // Touching or interpenetrating (only possible at the start): measure the depth.
-                let sep = mesh_separation(
+                // The candidates already touch: only the depth is left to find.
+                let (depth, pa, pb) = mesh_penetration(
                     MeshRef {
                         mesh: ma,
                         bvh: &a.shape.geometry.bvh,
@@ -416,10 +420,12 @@ fn advance_with(
                     },
                     &pose_b,
                 );
-                contact.depth_mm = sep.penetration;
-                contact.points = [sep.point_a, sep.point_b];
-                if let Some(n) = (sep.point_b - sep.point_a).try_normalize() {
-                    contact.normal = if sep.penetration > 0.0 { -n } else { n };
+                if depth > 0.0 {
+                    contact.depth_mm = depth;
+                    contact.points = [pa, pb];
+                    if let Some(n) = (pb - pa).try_normalize() {
+                        contact.normal = -n;
+                    }
                 }
             }
             return Some(contact);
