@@ -53,7 +53,11 @@ use crate::geometry::{
 };
 
 /// Growth margins of the candidates, as fractions of the leaf spacing s.
-const GROWTH: [f32; 10] = [0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37];
+const GROWTH: [f32; 12] = [
+    0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63,
+];
+/// How many of `GROWTH` budgets of 512 leaves and more use: wider margins are never chosen there.
+const GROWTH_FINE: usize = 10;
 /// The same for budgets under 64 leaves, whose few spheres must each cover much more of the tooth.
 const GROWTH_WIDE: [f32; 16] = [
     0.025, 0.04, 0.06, 0.08, 0.11, 0.14, 0.18, 0.23, 0.29, 0.37, 0.48, 0.63, 0.85, 1.15, 1.5, 2.0,
@@ -274,8 +278,10 @@ fn candidates(
     let mut near = Vec::new();
     let growth: &[f32] = if max_leaves < 64 {
         &GROWTH_WIDE
-    } else {
+    } else if max_leaves < 512 {
         &GROWTH
+    } else {
+        &GROWTH[..GROWTH_FINE]
     };
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); growth.len()];
     let mut radii = Vec::with_capacity(growth.len());
@@ -407,17 +413,14 @@ impl Covers {
 
 /// Greedy weighted set cover (newly covered area per (cost + λ)), with gains kept up to date as
 /// pieces are covered; returns the chosen candidates in order.
-fn greedy(c: &Candidates, covers: &Covers, area: &[f32], lambda: f64) -> Vec<u32> {
-    let mut gain: Vec<f64> = c
-        .list
-        .iter()
-        .map(|x| {
-            c.pool[x.first as usize..(x.first + x.len) as usize]
-                .iter()
-                .map(|&i| area[i as usize] as f64)
-                .sum()
-        })
-        .collect();
+fn greedy(
+    c: &Candidates,
+    covers: &Covers,
+    area: &[f32],
+    initial_gain: &[f64],
+    lambda: f64,
+) -> Vec<u32> {
+    let mut gain = initial_gain.to_vec();
     let mut left: Vec<u32> = c.list.iter().map(|x| x.len).collect();
     let mut version = vec![0u32; c.list.len()];
     let key = |k: usize, gain: f64| gain / (c.list[k].cost + lambda).max(1e-12);
@@ -465,8 +468,19 @@ fn greedy(c: &Candidates, covers: &Covers, area: &[f32], lambda: f64) -> Vec<u32
 fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
     let covers = Covers::new(c, area.len());
+    // Each candidate's area: the same for every run.
+    let initial_gain: Vec<f64> = c
+        .list
+        .iter()
+        .map(|x| {
+            c.pool[x.first as usize..(x.first + x.len) as usize]
+                .iter()
+                .map(|&i| area[i as usize] as f64)
+                .sum()
+        })
+        .collect();
     let run = |lambda: f64| {
-        let mut chosen = greedy(c, &covers, area, lambda);
+        let mut chosen = greedy(c, &covers, area, &initial_gain, lambda);
         prune(c, &mut chosen, area.len());
         chosen
     };

@@ -6,21 +6,24 @@
 //! from the local origin), so the inflated sphere moving linearly always contains the real one. For
 //! a node pair the relative centre is A + B·t (A = start offset, B = change over the step):
 //!
-//! 1. **Interval test.** |A + B·[0, 1]|² is bounded below with outward-rounded interval arithmetic;
-//!    if the bound exceeds (r₁ + r₂)² the spheres cannot meet during the step.
+//! 1. **Interval test.** |A + B·[0, 1]|² is bounded below component by component (each component
+//!    of A + B·t lies between its values at t = 0 and t = 1); if the bound exceeds (r₁ + r₂)² the
+//!    spheres cannot meet during the step. It runs on eight sibling spheres at once, in f32, with
+//!    the contact distance widened by the rounding slack of [`super::lanes`].
 //! 2. **First time (Eq. 2)**, for every node pair that passes, inner or leaf:
 //!    t = (|A|² − R²) / (−A·B + √((A·B)² − |B|²(|A|² − R²))), the conjugate form of the paper's
 //!    root, which has no cancellation; overlap at t = 0 gives 0; |B|² = 0, A·B ≥ 0 or a negative
 //!    discriminant give no contact (the spheres are apart at t = 0 and never approach). Every
 //!    coefficient is bracketed by a forward error bound and the root taken from the bounds that
 //!    make it smallest, so for the given A, B and R the time is never after the true one (see
-//!    [`first_contact`]); R carries a slack above the rounding of the transformed centres, so the
-//!    same holds for the real motion.
+//!    [`first_contact`]); R carries the f32 slack of the mapped centres, so the same holds for the
+//!    real motion.
 //!
 //! A node pair's time bounds its descendants' from below, so the search visits pairs earliest first
 //! and, for the continuous method, skips pairs that cannot beat the earliest leaf time found. The
 //! pair's time of contact is the least leaf time in [0, 1). ([`may_meet`], the interval test plus
-//! the exact minimum of the quadratic, serves the broad phase.)
+//! the exact minimum of the quadratic in f64, serves the broad phase; [`interval_may_meet`] is its
+//! outward-rounded f64 interval test.)
 //!
 //! [`Motion::arc_factor`]: crate::collision::motion::Motion::arc_factor
 
@@ -77,12 +80,6 @@ pub fn may_meet(a: DVec3, b: DVec3, r: f64) -> bool {
     };
     let m = (a + b * t).length_squared();
     m - 1e-12 * (a.length_squared() + bb) - 1e-300 <= rr
-}
-
-/// What the contact distance is widened by when sphere centres are computed (in f64) from
-/// coordinates up to `scale` mm: far above the rounding of the relative centres A and B.
-pub fn rounding_slack(scale: f64) -> f64 {
-    1e-13 * scale + 1e-9
 }
 
 /// First time in [0, 1) at which spheres with relative centre A + B·t come within `r`, rounded
