@@ -83,6 +83,35 @@ impl Motion {
     pub fn speed_bound(&self, rho: f64) -> f64 {
         self.travel() + self.angle() * rho
     }
+
+    /// The rotation's world axis (unit; any unit vector when the step does not rotate).
+    pub fn axis(&self) -> DVec3 {
+        let (q0, q1) = (dquat(self.start.rotation), dquat(self.end.rotation));
+        // Shortest path, as slerp takes it.
+        let q1 = if q0.dot(q1) < 0.0 { -q1 } else { q1 };
+        let d = q1 * q0.inverse();
+        DVec3::new(d.x, d.y, d.z)
+            .try_normalize()
+            .unwrap_or(DVec3::X)
+    }
+
+    /// Bound on the speed (mm per unit t) of the given points (local frame) over the step: the
+    /// rotation turns about a fixed world axis through the moving origin, so a point's speed is at
+    /// most the origin's plus the angle times the point's distance from that axis, which the
+    /// rotation does not change. Never above [`Motion::speed_bound`] of the points' largest |p|.
+    pub fn speed_bound_of(&self, points: impl Iterator<Item = Vec3>) -> f64 {
+        let theta = self.angle();
+        if theta <= 0.0 {
+            return self.travel();
+        }
+        let k = self.axis();
+        let r0 = dquat(self.start.rotation);
+        let far = points
+            .map(|p| k.cross(r0 * p.as_dvec3()).length())
+            .fold(0.0, f64::max);
+        // The axis is rounded in f64: widen by far more than its error.
+        self.travel() + theta * far * (1.0 + 1e-9)
+    }
 }
 
 /// f64 copy of a pose, for the conservative stages.
@@ -199,5 +228,51 @@ mod tests {
             }
         }
         assert_eq!(Motion::still(Pose::IDENTITY).arc_factor(), 0.0);
+    }
+
+    #[test]
+    fn point_speeds_stay_within_the_axis_bound() {
+        let p = [
+            Vec3::new(3.0, -7.0, 2.0),
+            Vec3::new(-1.0, 0.5, 4.0),
+            Vec3::ZERO,
+        ];
+        for (axis, angle) in [
+            (Vec3::Z, 0.3f32),
+            (Vec3::new(1.0, 2.0, -0.5).normalize(), -1.2),
+            (Vec3::Y, 3.0),
+        ] {
+            let m = Motion {
+                start: Pose::new(Quat::from_rotation_x(0.7), Vec3::new(1.0, 2.0, 3.0)),
+                end: Pose::new(
+                    Quat::from_axis_angle(axis, angle) * Quat::from_rotation_x(0.7),
+                    Vec3::new(1.5, 2.0, 2.5),
+                ),
+            };
+            let bound = m.speed_bound_of(p.iter().copied());
+            let loose = m.speed_bound(p.iter().map(|q| q.length() as f64).fold(0.0, f64::max));
+            assert!(bound <= loose + 1e-12, "{bound} > {loose}");
+            // Finite differences of the real motion never exceed the bound.
+            for q in p {
+                for i in 0..400 {
+                    let (t0, t1) = (i as f32 / 400.0, (i + 1) as f32 / 400.0);
+                    let d = m
+                        .at(t1)
+                        .transform_point(q)
+                        .distance(m.at(t0).transform_point(q));
+                    assert!(
+                        (d / (t1 - t0)) as f64 <= bound * (1.0 + 1e-3) + 1e-4,
+                        "angle {angle}: speed {} > {bound}",
+                        d / (t1 - t0)
+                    );
+                }
+            }
+        }
+        // Points on the axis move only with the origin.
+        let m = Motion {
+            start: Pose::IDENTITY,
+            end: Pose::new(Quat::from_rotation_z(0.5), Vec3::new(0.2, 0.0, 0.0)),
+        };
+        assert!((m.speed_bound_of([Vec3::new(0.0, 0.0, 9.0)].into_iter()) - 0.2).abs() < 1e-6);
     }
 }

@@ -22,7 +22,8 @@
 //! other's plane, a lower bound that is nearly exact for the facing triangles of teeth in contact)
 //! already show it farther than the best; no point of the candidates
 //! moves faster than μ = Σ (origin travel + rotation angle × farthest candidate vertex from the
-//! origin) per unit time ([`Motion::speed_bound`]), so the gap cannot close before t + d/μ. Each
+//! rotation axis) per unit time ([`Motion::speed_bound_of`]), so the gap cannot close before
+//! t + d/μ. Each
 //! step advances by (d − tolerance/2)/μ, leaving at least half the tolerance, and stops when
 //! d ≤ [`GAP_TOLERANCE_MM`]: the reported time is never after the first contact and the gap left
 //! there is within the tolerance. Between steps each triangle pair keeps its last distance: it
@@ -31,7 +32,7 @@
 //! interpenetrating at t = 0 report time 0 and the penetration depth of the whole meshes. After [`MAX_STEPS`] steps (slow convergence under large
 //! rotations) the current, still conservative, time is reported with its gap.
 //!
-//! [`Motion::speed_bound`]: crate::collision::motion::Motion::speed_bound
+//! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
 
 use glam::{DVec3, Vec3};
 
@@ -289,14 +290,10 @@ fn advance_with(
         }
         leaf_pairs.push((i, j, first..pairs.len()));
     }
-    let rho = |mesh: &crate::geometry::TriMesh, ids: &[u32]| {
-        ids.iter()
-            .flat_map(|&t| mesh.triangle(t as usize))
-            .map(|v| v.length() as f64)
-            .fold(0.0, f64::max)
+    let speed = |motion: &Motion, mesh: &crate::geometry::TriMesh, ids: &[u32]| {
+        motion.speed_bound_of(ids.iter().flat_map(|&t| mesh.triangle(t as usize)))
     };
-    let mu = (a.motion.speed_bound(rho(ma, &ids_a)) + b.motion.speed_bound(rho(mb, &ids_b)))
-        * (1.0 + 1e-6);
+    let mu = (speed(&a.motion, ma, &ids_a) + speed(&b.motion, mb, &ids_b)) * (1.0 + 1e-6);
     let tol = GAP_TOLERANCE_MM as f64;
     let mut t = swept
         .leaf_times
