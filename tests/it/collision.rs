@@ -25,10 +25,19 @@ struct TestTooth {
 }
 
 fn teeth(method: TreeMethod, depth: u32, pairs: &[(u8, u8)]) -> Vec<(TestTooth, TestTooth)> {
+    teeth_branching(method, 8, depth, pairs)
+}
+
+fn teeth_branching(
+    method: TreeMethod,
+    branching: u32,
+    depth: u32,
+    pairs: &[(u8, u8)],
+) -> Vec<(TestTooth, TestTooth)> {
     let d = Dentition::build(Case::resolve("normal").unwrap()).unwrap();
     let settings = TreeSettings {
         method,
-        branching: 8,
+        branching,
         depth,
     };
     let make = |n: u8| {
@@ -196,6 +205,21 @@ fn medial_trees_keep_the_guarantees() {
     assert_eq!(t.false_negatives, [0; 4], "{t:?}");
     assert_eq!(t.late, 0, "{t:?}");
     assert_eq!(t.gap_errors, 0, "{t:?}");
+}
+
+/// The descents test children eight at a time: branchings with part-filled groups (3) and with
+/// more than one group per node (12) keep every guarantee too.
+#[test]
+fn other_branchings_keep_the_guarantees() {
+    for (branching, depth) in [(3, 4), (12, 3)] {
+        let pairs = teeth_branching(TreeMethod::Medial, branching, depth, &PAIRS[..2]);
+        let t = run(&pairs, 300, 0xb4a9_c4e5 + branching as u64, true);
+        eprintln!("branching {branching}: {t:?}");
+        assert!(t.touching > 20, "{t:?}");
+        assert_eq!(t.false_negatives, [0; 4], "{t:?}");
+        assert_eq!(t.late, 0, "{t:?}");
+        assert_eq!(t.gap_errors, 0, "{t:?}");
+    }
 }
 
 /// Checks the continuous and exact methods against parry sampled at 256 times: no miss, never late.
