@@ -79,48 +79,9 @@ fn closest_point_segment_f64(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
 /// Closest points between segments `p1 q1` and `p2 q2` (Ericson 5.1.9), degenerate segments
 /// included, computed in f64. Returns the two points.
 pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) -> (Vec3, Vec3) {
-    const EPS: f64 = 1e-18;
     let [p1, q1, p2, q2] = [p1, q1, p2, q2].map(|v| v.as_dvec3());
-    let d1 = q1 - p1;
-    let d2 = q2 - p2;
-    let r = p1 - p2;
-    let a = d1.length_squared();
-    let e = d2.length_squared();
-    let f = d2.dot(r);
-    let (s, t);
-    if a <= EPS && e <= EPS {
-        return (p1.as_vec3(), p2.as_vec3());
-    }
-    if a <= EPS {
-        s = 0.0;
-        t = (f / e).clamp(0.0, 1.0);
-    } else {
-        let c = d1.dot(r);
-        if e <= EPS {
-            t = 0.0;
-            s = (-c / a).clamp(0.0, 1.0);
-        } else {
-            let b = d1.dot(d2);
-            let denom = a * e - b * b;
-            let s0 = if denom > 1e-12 * a * e {
-                ((b * f - c * e) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let t0 = (b * s0 + f) / e;
-            if t0 < 0.0 {
-                t = 0.0;
-                s = (-c / a).clamp(0.0, 1.0);
-            } else if t0 > 1.0 {
-                t = 1.0;
-                s = ((b - c) / a).clamp(0.0, 1.0);
-            } else {
-                t = t0;
-                s = s0;
-            }
-        }
-    }
-    ((p1 + d1 * s).as_vec3(), (p2 + d2 * t).as_vec3())
+    let (a, b) = segment_points_f64(p1, q1, p2, q2);
+    (a.as_vec3(), b.as_vec3())
 }
 
 /// Closest points between two triangles and their distance.
@@ -302,7 +263,7 @@ fn vertex_over_face(
 
 /// Closest points of segments `p1 q1` and `p2 q2` in f64 (Ericson 5.1.9), degenerate segments
 /// included.
-#[inline]
+#[inline(always)]
 fn segment_points_f64(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> (DVec3, DVec3) {
     const EPS: f64 = 1e-18;
     let d1 = q1 - p1;
@@ -397,40 +358,74 @@ fn exhaustive(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
     best
 }
 
+/// A triangle's plane in f64: unit normal and offset (n · p = offset on the plane). Needles (sine
+/// of the angle below 10⁻⁶), whose normal is not trusted, get a zero normal and bound nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FacePlane {
+    /// Unit normal (zero for a needle).
+    pub normal: DVec3,
+    /// n · (first vertex).
+    pub offset: f64,
+}
+
+impl FacePlane {
+    /// The plane of `t`.
+    #[inline]
+    pub fn of(t: &[Vec3; 3]) -> Self {
+        let p = t[0].as_dvec3();
+        let (e1, e2) = (t[1].as_dvec3() - p, t[2].as_dvec3() - p);
+        let n = e1.cross(e2);
+        let len2 = n.length_squared();
+        let normal = if len2 > 1e-12 * e1.length_squared() * e2.length_squared() && len2 > 0.0 {
+            n / len2.sqrt()
+        } else {
+            DVec3::ZERO
+        };
+        Self {
+            normal,
+            offset: normal.dot(p),
+        }
+    }
+
+    /// How far all of `o` lies beyond the plane, on either side (0 if it straddles the plane).
+    #[inline]
+    pub fn beyond(&self, o: &[Vec3; 3]) -> f64 {
+        let s = o.map(|p| self.normal.dot(p.as_dvec3()) - self.offset);
+        if s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0 {
+            s[0].min(s[1]).min(s[2])
+        } else if s[0] < 0.0 && s[1] < 0.0 && s[2] < 0.0 {
+            -(s[0].max(s[1]).max(s[2]))
+        } else {
+            0.0
+        }
+    }
+}
+
 /// A lower bound of the distance between two triangles: how far one lies beyond the other's
 /// plane (0 when neither lies wholly on one side, or a triangle is a needle). Computed in f64 and
 /// rounded down, so never above the exact distance.
 #[inline]
 pub fn triangle_plane_gap(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> f32 {
-    #[inline]
-    fn beyond(t: &[Vec3; 3], o: &[Vec3; 3]) -> f64 {
-        let p = t[0].as_dvec3();
-        let (e1, e2) = (t[1].as_dvec3() - p, t[2].as_dvec3() - p);
-        let n = e1.cross(e2);
-        let len2 = n.length_squared();
-        // Needles (sine of the angle below 10⁻⁶): the normal is not trusted.
-        if len2 <= 1e-12 * e1.length_squared() * e2.length_squared() || len2 == 0.0 {
-            return 0.0;
-        }
-        let d = o.map(|v| v.as_dvec3() - p);
-        let s = d.map(|v| n.dot(v));
-        let m = if s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0 {
-            s[0].min(s[1]).min(s[2])
-        } else if s[0] < 0.0 && s[1] < 0.0 && s[2] < 0.0 {
-            -(s[0].max(s[1]).max(s[2]))
-        } else {
-            return 0.0;
-        };
-        // The normal's direction is off by at most ~10⁻¹⁶ / sine ≤ 10⁻¹⁰ and each product by
-        // a few ulps: shrink by far more than both.
-        let scale = d
-            .iter()
-            .chain([&e1, &e2])
-            .map(|v| v.abs().max_element())
-            .fold(0.0, f64::max);
-        m / len2.sqrt() * (1.0 - 1e-9) - 1e-8 * scale
+    plane_gap(t1, &FacePlane::of(t1), t2, &FacePlane::of(t2))
+}
+
+/// [`triangle_plane_gap`] with the planes given (for callers that measure a triangle against
+/// many others). The unit normal's direction is within 10⁻¹⁰ (sine ≥ 10⁻⁶, f64) and each signed
+/// distance within a few ulps of the coordinates: the bound is shrunk by 10⁻⁸ of the triangles'
+/// spread and 10⁻¹⁴ of their distance from the origin, far more than both.
+#[inline]
+pub fn plane_gap(t1: &[Vec3; 3], p1: &FacePlane, t2: &[Vec3; 3], p2: &FacePlane) -> f32 {
+    let m = p1.beyond(t2).max(p2.beyond(t1));
+    if m <= 0.0 {
+        return 0.0;
     }
-    (beyond(t2, t1).max(beyond(t1, t2)).max(0.0) as f32) * (1.0 - 1e-6)
+    let (mut near, mut far) = (0.0f32, 0.0f32);
+    for v in t1.iter().chain(t2) {
+        near = near.max((*v - t1[0]).abs().max_element());
+        far = far.max(v.abs().max_element());
+    }
+    let margin = 1e-8 * near as f64 + 1e-14 * far as f64;
+    ((m - margin).max(0.0) as f32) * (1.0 - 1e-6)
 }
 
 #[cfg(test)]

@@ -36,7 +36,7 @@ use super::{
 use crate::{
     collision::{
         motion::{DPose, NodeCache},
-        shape::CompactTree,
+        shape::{Chunk, CompactTree},
     },
     geometry::interval::Interval,
 };
@@ -218,6 +218,24 @@ fn pair_time(a: (Vec3, Vec3, f32), b: (Vec3, Vec3, f32), slack: f32) -> Option<f
     first_contact(start, change, r)
 }
 
+/// Calls `push(node, lane, time)` for each lane of a chunk whose swept sphere meets `other`'s
+/// during the step, with the pair's first time. (The time is symmetric in the two spheres.)
+#[inline]
+fn meeting_lanes(
+    ch: &Chunk,
+    sw: &SweptChunk,
+    other: (Vec3, Vec3, f32),
+    slack: f32,
+    mut push: impl FnMut(u32, (Vec3, Vec3, f32), f64),
+) {
+    for l in bits(swept_mask(sw, other.0, other.1, other.2, slack, ch.used())) {
+        let lane = sw.lane(l);
+        if let Some(t) = pair_time(lane, other, slack) {
+            push(ch.node[l], lane, t);
+        }
+    }
+}
+
 fn descend(
     q: Descent,
     cache_a: &mut NodeCache<SweptChunk>,
@@ -266,35 +284,17 @@ fn descend(
             for c in ta.child_chunks[i].clone() {
                 let ch = &ta.chunks[c as usize];
                 let sw = cache_a.get_ref(c as usize, || SweptChunk::new(ch, &a0, &a1, ka));
-                let (b_start, b_end, b_r) = it.b;
-                for l in bits(swept_mask(sw, b_start, b_end, b_r, slack, ch.used())) {
-                    let a = sw.lane(l);
-                    if let Some(t) = pair_time(a, it.b, slack) {
-                        stack.push(Item {
-                            i: ch.node[l],
-                            t,
-                            a,
-                            ..it
-                        });
-                    }
-                }
+                meeting_lanes(ch, sw, it.b, slack, |i, a, t| {
+                    stack.push(Item { i, t, a, ..it })
+                });
             }
         } else {
             for c in tb.child_chunks[j].clone() {
                 let ch = &tb.chunks[c as usize];
                 let sw = cache_b.get_ref(c as usize, || SweptChunk::new(ch, &b0, &b1, kb));
-                let (a_start, a_end, a_r) = it.a;
-                for l in bits(swept_mask(sw, a_start, a_end, a_r, slack, ch.used())) {
-                    let b = sw.lane(l);
-                    if let Some(t) = pair_time(it.a, b, slack) {
-                        stack.push(Item {
-                            j: ch.node[l],
-                            t,
-                            b,
-                            ..it
-                        });
-                    }
-                }
+                meeting_lanes(ch, sw, it.a, slack, |j, b, t| {
+                    stack.push(Item { j, t, b, ..it })
+                });
             }
         }
         if earliest_only {

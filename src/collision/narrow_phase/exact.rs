@@ -34,12 +34,12 @@
 //!
 //! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use super::lanes::Affine32;
 use super::{Body, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion, NodeCache};
-use crate::geometry::{MeshRef, closest_points_triangle_triangle, mesh_penetration};
+use crate::geometry::{FacePlane, MeshRef, closest_points_triangle_triangle, mesh_penetration};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -52,60 +52,33 @@ pub const MAX_STEPS: u32 = 1000;
 /// measured at, far above either, when it is carried forward as a bound.
 const LIPSCHITZ_SLACK_MM: f64 = 1e-4;
 
-/// One candidate triangle placed at the current time: vertices, bounding sphere, and unit normal
-/// with its plane offset (zero normal for needles, whose normal is not trusted).
+/// One candidate triangle placed at the current time: vertices, bounding sphere and plane.
 #[derive(Clone, Copy, Default)]
 struct PlacedTri {
     v: [Vec3; 3],
     centre: Vec3,
     radius: f32,
-    normal: DVec3,
-    offset: f64,
+    plane: FacePlane,
 }
 
 impl PlacedTri {
     fn new(v: [Vec3; 3]) -> Self {
         let centre = (v[0] + v[1] + v[2]) / 3.0;
         let radius = v.iter().map(|p| p.distance(centre)).fold(0.0f32, f32::max);
-        let p0 = v[0].as_dvec3();
-        let (e1, e2) = (v[1].as_dvec3() - p0, v[2].as_dvec3() - p0);
-        let n = e1.cross(e2);
-        let len2 = n.length_squared();
-        // Needles (sine below 10⁻⁶) get no plane.
-        let normal = if len2 > 1e-12 * e1.length_squared() * e2.length_squared() && len2 > 0.0 {
-            n / len2.sqrt()
-        } else {
-            DVec3::ZERO
-        };
         Self {
             v,
             centre,
             radius,
-            normal,
-            offset: normal.dot(p0),
+            plane: FacePlane::of(&v),
         }
     }
 
-    /// How far all of `o` lies beyond this triangle's plane, on either side (0 if it straddles).
-    #[inline]
-    fn beyond(&self, o: &[Vec3; 3]) -> f64 {
-        let s = o.map(|p| self.normal.dot(p.as_dvec3()) - self.offset);
-        if s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0 {
-            s[0].min(s[1]).min(s[2])
-        } else if s[0] < 0.0 && s[1] < 0.0 && s[2] < 0.0 {
-            -(s[0].max(s[1]).max(s[2]))
-        } else {
-            0.0
-        }
-    }
-
-    /// A lower bound of the distance to `o` ([`crate::geometry::triangle_plane_gap`] with the
-    /// planes computed once per step). The unit normal's direction is within 10⁻⁹ (sine ≥ 10⁻⁶,
-    /// f64) and each signed distance within a few ulps of the coordinates; the margin covers
-    /// both with room to spare.
+    /// A lower bound of the distance to `o`: the plane gap of [`crate::geometry::plane_gap`],
+    /// with each plane computed once per step and its rounding margin taken from the bounding
+    /// spheres (which bound the triangles' spread and their distance from the origin).
     #[inline]
     fn gap_to(&self, o: &PlacedTri) -> f32 {
-        let m = self.beyond(&o.v).max(o.beyond(&self.v));
+        let m = self.plane.beyond(&o.v).max(o.plane.beyond(&self.v));
         if m <= 0.0 {
             return 0.0;
         }

@@ -83,85 +83,71 @@ pub fn overlapping_leaves(
                 stack,
             );
         }
+        let second = Second {
+            tree: tb,
+            rel,
+            slack,
+        };
         while let Some(it) = stack.pop() {
-            let (i, j) = (it.i as usize, it.j as usize);
-            let (la, lb) = (it.leaf_a, it.leaf_b);
-            if la {
-                // Split b.
-                for c in tb.child_chunks[j].clone() {
-                    let ch = &tb.chunks[c as usize];
-                    let xyz = cache.get_ref(c as usize, || rel.apply_chunk(ch));
-                    for k in bits(overlap_mask(
-                        xyz3(xyz),
-                        &ch.r,
-                        it.a,
-                        it.ra,
-                        slack,
-                        ch.used(),
-                    )) {
-                        let b = Vec3::new(xyz[0][k], xyz[1][k], xyz[2][k]);
-                        let leaf_b = ch.leaves >> k & 1 != 0;
-                        emit(
-                            Item {
-                                j: ch.node[k],
-                                b,
-                                rb: ch.r[k],
-                                leaf_b,
-                                ..it
-                            },
-                            stack,
-                        );
-                    }
-                }
+            if it.leaf_a {
+                second.split(&it, cache, |child| emit(child, stack));
                 continue;
             }
             // Split a; when b is inner too, split b under each of a's children that meets it.
-            for c in ta.child_chunks[i].clone() {
+            for c in ta.child_chunks[it.i as usize].clone() {
                 let ch = &ta.chunks[c as usize];
                 let xyz = [&ch.x, &ch.y, &ch.z];
                 for k in bits(overlap_mask(xyz, &ch.r, it.b, it.rb, slack, ch.used())) {
-                    let a = Vec3::new(ch.x[k], ch.y[k], ch.z[k]);
-                    let leaf_a = ch.leaves >> k & 1 != 0;
                     let child = Item {
                         i: ch.node[k],
-                        a,
+                        a: Vec3::new(ch.x[k], ch.y[k], ch.z[k]),
                         ra: ch.r[k],
-                        leaf_a,
+                        leaf_a: ch.leaves >> k & 1 != 0,
                         ..it
                     };
-                    if lb {
+                    if it.leaf_b {
                         emit(child, stack);
-                        continue;
-                    }
-                    for d in tb.child_chunks[j].clone() {
-                        let dh = &tb.chunks[d as usize];
-                        let xyz = cache.get_ref(d as usize, || rel.apply_chunk(dh));
-                        for l in bits(overlap_mask(
-                            xyz3(xyz),
-                            &dh.r,
-                            a,
-                            child.ra,
-                            slack,
-                            dh.used(),
-                        )) {
-                            let b = Vec3::new(xyz[0][l], xyz[1][l], xyz[2][l]);
-                            let leaf_b = dh.leaves >> l & 1 != 0;
-                            emit(
-                                Item {
-                                    j: dh.node[l],
-                                    b,
-                                    rb: dh.r[l],
-                                    leaf_b,
-                                    ..child
-                                },
-                                stack,
-                            );
-                        }
+                    } else {
+                        second.split(&child, cache, |grandchild| emit(grandchild, stack));
                     }
                 }
             }
         }
     });
+}
+
+/// The second tree, mapped into the first tree's frame.
+struct Second<'t> {
+    tree: &'t CompactTree,
+    rel: Affine32,
+    slack: f32,
+}
+
+impl Second<'_> {
+    /// Calls `emit` with `base` paired with each child of its second-tree node that meets its
+    /// first-tree sphere (children mapped once per query, in `cache`).
+    #[inline]
+    fn split(
+        &self,
+        base: &Item,
+        cache: &mut NodeCache<[[f32; LANES]; 3]>,
+        mut emit: impl FnMut(Item),
+    ) {
+        for c in self.tree.child_chunks[base.j as usize].clone() {
+            let ch = &self.tree.chunks[c as usize];
+            let xyz = cache.get_ref(c as usize, || self.rel.apply_chunk(ch));
+            let mask = overlap_mask(xyz3(xyz), &ch.r, base.a, base.ra, self.slack, ch.used());
+            for k in bits(mask) {
+                emit(Item {
+                    j: ch.node[k],
+                    b: Vec3::new(xyz[0][k], xyz[1][k], xyz[2][k]),
+                    rb: ch.r[k],
+                    leaf_b: ch.leaves >> k & 1 != 0,
+                    ..*base
+                });
+            }
+        }
+    }
 }
 
 #[inline]
