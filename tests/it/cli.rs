@@ -9,15 +9,20 @@ fn orthosim(args: &[&str]) -> std::process::Output {
         .expect("the orthosim binary runs")
 }
 
-/// Runs `orthosim` with `args`, which must succeed, and parses its one JSON object.
-fn json_of(args: &[&str]) -> serde_json::Value {
+/// Runs `orthosim` with `args`, which must succeed (else the test fails with its stderr).
+fn succeed(args: &[&str]) -> std::process::Output {
     let out = orthosim(args);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
+    out
+}
+
+/// Runs `orthosim` with `args`, which must succeed, and parses its one JSON object.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&succeed(args).stdout).expect("one JSON object")
 }
 
 /// An empty folder private to this test process.
@@ -42,12 +47,7 @@ fn cases_lists_the_four_builtin_cases() {
 
 #[test]
 fn inspect_normal_meets_the_arrangement_figures() {
-    let out = orthosim(&["inspect", "--case", "normal", "--json"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&["inspect", "--case", "normal", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert_eq!(v["case"], "normal");
     let teeth = v["teeth"].as_array().unwrap();
@@ -152,7 +152,7 @@ fn help_lists_the_subcommands() {
 #[test]
 fn trees_reports_covering_octrees_and_writes_sph_files() {
     let dir = std::env::temp_dir().join(format!("orthosim-trees-{}", std::process::id()));
-    let out = orthosim(&[
+    let out = succeed(&[
         "trees",
         "--case",
         "normal",
@@ -164,11 +164,6 @@ fn trees_reports_covering_octrees_and_writes_sph_files() {
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert_eq!(
         (
@@ -233,7 +228,7 @@ fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
     let cache = std::env::temp_dir().join(format!("orthosim-tree-cache-{}", std::process::id()));
     std::fs::remove_dir_all(&cache).ok();
     let run = || {
-        let out = orthosim(&[
+        let out = succeed(&[
             "trees",
             "--method",
             "medial",
@@ -243,11 +238,6 @@ fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
             "--cache",
             cache.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("one JSON object")
     };
     let first = run();
@@ -277,7 +267,7 @@ fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
 
 #[test]
 fn bench_reports_every_method_with_no_false_negatives() {
-    let out = orthosim(&[
+    let out = succeed(&[
         "bench",
         "--pairs",
         "60",
@@ -286,11 +276,6 @@ fn bench_reports_every_method_with_no_false_negatives() {
         "--no-cache",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert_eq!(v["pairs"], 60);
     assert!(v["full_mouth_step_us"].as_f64().unwrap() > 0.0);
@@ -331,7 +316,7 @@ fn bench_reports_every_method_with_no_false_negatives() {
 
 #[test]
 fn simulate_reports_the_contract_keys() {
-    let out = orthosim(&[
+    let out = succeed(&[
         "simulate",
         "--case",
         "case3",
@@ -344,11 +329,6 @@ fn simulate_reports_the_contract_keys() {
         "40",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     for key in [
         "case",
@@ -400,7 +380,7 @@ fn simulate_refuses_unknown_cases_and_bad_options_in_one_line() {
 fn report_writes_every_file_its_page_refers_to() {
     let dir = std::env::temp_dir().join(format!("orthosim-report-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = orthosim(&[
+    succeed(&[
         "report",
         "--case",
         "case3",
@@ -412,11 +392,6 @@ fn report_writes_every_file_its_page_refers_to() {
         "3",
         "--no-cache",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let mut refs = Vec::new();
     for attr in ["href=\"", "src=\""] {
@@ -490,18 +465,13 @@ fn report_writes_every_file_its_page_refers_to() {
 #[test]
 fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
     let dir = fresh_dir("export");
-    let out = orthosim(&[
+    succeed(&[
         "export-case",
         "--case",
         "case1",
         "--out",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let case = dir.join("case1.ron");
     assert!(case.exists());
     assert_eq!(
