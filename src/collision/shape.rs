@@ -49,8 +49,6 @@ impl Chunk {
 pub struct CompactTree {
     /// Node spheres (local frame); node 0 is the root.
     pub spheres: Vec<Sphere>,
-    /// Distance of each node's centre from the local origin (for the rotation bound).
-    pub rho: Vec<f32>,
     /// First child of each node.
     pub first: Vec<u32>,
     /// Number of children (0 for a leaf).
@@ -70,7 +68,6 @@ impl CompactTree {
     pub fn new(tree: &SphereTree) -> Self {
         let mut out = Self {
             spheres: Vec::new(),
-            rho: Vec::new(),
             first: Vec::new(),
             count: Vec::new(),
             triangles: Vec::new(),
@@ -103,20 +100,23 @@ impl CompactTree {
                 queue.push_back(c);
             }
         }
-        out.rho = out.spheres.iter().map(|s| s.centre.length()).collect();
-        out.max_rho = out.rho.iter().copied().fold(0.0, f32::max);
+        out.max_rho = out
+            .spheres
+            .iter()
+            .map(|s| s.centre.length())
+            .fold(0.0, f32::max);
         out.pack();
         out
     }
 
     /// Fills `chunks` and `child_chunks` from the node arrays.
     fn pack(&mut self) {
-        let lane = |chunk: &mut Chunk, k: usize, node: usize, s: &Sphere, rho: f32| {
+        let lane = |chunk: &mut Chunk, k: usize, node: usize, s: &Sphere| {
             chunk.x[k] = s.centre.x;
             chunk.y[k] = s.centre.y;
             chunk.z[k] = s.centre.z;
             chunk.r[k] = s.radius;
-            chunk.rho[k] = rho;
+            chunk.rho[k] = s.centre.length();
             chunk.node[k] = node as u32;
             chunk.len = k as u32 + 1;
         };
@@ -126,7 +126,7 @@ impl CompactTree {
             }
         };
         let mut root = Chunk::default();
-        lane(&mut root, 0, 0, &self.spheres[0], self.rho[0]);
+        lane(&mut root, 0, 0, &self.spheres[0]);
         leaf(&mut root, 0, 0, &self.count);
         self.chunks = vec![root];
         self.child_chunks = Vec::with_capacity(self.spheres.len());
@@ -136,7 +136,7 @@ impl CompactTree {
             for group in kids.chunks(LANES) {
                 let mut c = Chunk::default();
                 for (k, &n) in group.iter().enumerate() {
-                    lane(&mut c, k, n, &self.spheres[n], self.rho[n]);
+                    lane(&mut c, k, n, &self.spheres[n]);
                     leaf(&mut c, k, n, &self.count);
                 }
                 self.chunks.push(c);
