@@ -14,6 +14,7 @@
 //! origin, 10⁻⁶ mm near it).
 
 use glam::{DMat3, DQuat, DVec3, Mat3, Vec3};
+use wide::f32x8;
 
 use crate::collision::shape::{Chunk, LANES};
 
@@ -59,13 +60,16 @@ impl Affine32 {
     #[inline]
     pub fn apply_chunk(&self, c: &Chunk) -> [[f32; LANES]; 3] {
         let (m, t) = (self.m, self.t);
-        let mut out = [[0.0; LANES]; 3];
-        for k in 0..LANES {
-            out[0][k] = m.x_axis.x * c.x[k] + m.y_axis.x * c.y[k] + m.z_axis.x * c.z[k] + t.x;
-            out[1][k] = m.x_axis.y * c.x[k] + m.y_axis.y * c.y[k] + m.z_axis.y * c.z[k] + t.y;
-            out[2][k] = m.x_axis.z * c.x[k] + m.y_axis.z * c.y[k] + m.z_axis.z * c.z[k] + t.z;
-        }
-        out
+        let (x, y, z) = (f32x8::from(c.x), f32x8::from(c.y), f32x8::from(c.z));
+        let row = |a: f32, b: f32, c: f32, t: f32| {
+            (f32x8::splat(a) * x + f32x8::splat(b) * y + f32x8::splat(c) * z + f32x8::splat(t))
+                .to_array()
+        };
+        [
+            row(m.x_axis.x, m.y_axis.x, m.z_axis.x, t.x),
+            row(m.x_axis.y, m.y_axis.y, m.z_axis.y, t.y),
+            row(m.x_axis.z, m.y_axis.z, m.z_axis.z, t.z),
+        ]
     }
 }
 
@@ -80,13 +84,11 @@ pub fn overlap_mask(
     slack: f32,
     used: u32,
 ) -> u32 {
-    let mut pass = [false; LANES];
-    for k in 0..LANES {
-        let (dx, dy, dz) = (x[k] - p.x, y[k] - p.y, z[k] - p.z);
-        let rr = (r[k] + rp + slack) * GROW;
-        pass[k] = dx * dx + dy * dy + dz * dz <= rr * rr;
-    }
-    to_mask(&pass) & used
+    let dx = f32x8::from(*x) - f32x8::splat(p.x);
+    let dy = f32x8::from(*y) - f32x8::splat(p.y);
+    let dz = f32x8::from(*z) - f32x8::splat(p.z);
+    let rr = (f32x8::from(*r) + f32x8::splat(rp) + f32x8::splat(slack)) * f32x8::splat(GROW);
+    (dx * dx + dy * dy + dz * dz).simd_le(rr * rr).to_bitmask() & used
 }
 
 /// Start and end centres and inflated radii of a chunk's lanes over a step.
@@ -133,35 +135,19 @@ impl SweptChunk {
 /// distance plus `slack`.
 #[inline]
 pub fn swept_mask(s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
-    let mut pass = [false; LANES];
-    for k in 0..LANES {
-        let mut lo = 0.0;
-        for (axis, (q0, q1)) in [(p0.x, p1.x), (p0.y, p1.y), (p0.z, p1.z)]
-            .into_iter()
-            .enumerate()
-        {
-            let a = s.start[axis][k] - q0;
-            let e = s.end[axis][k] - q1;
-            let m = if a * e > 0.0 {
-                a.abs().min(e.abs())
-            } else {
-                0.0
-            };
-            lo += m * m;
-        }
-        let rr = (s.r[k] + rp + slack) * GROW;
-        pass[k] = lo <= rr * rr;
+    let mut lo = f32x8::ZERO;
+    for (axis, (q0, q1)) in [(p0.x, p1.x), (p0.y, p1.y), (p0.z, p1.z)]
+        .into_iter()
+        .enumerate()
+    {
+        let a = f32x8::from(s.start[axis]) - f32x8::splat(q0);
+        let e = f32x8::from(s.end[axis]) - f32x8::splat(q1);
+        // The nearer end when both have the same sign, else zero (the interval spans 0).
+        let m = a.abs().min(e.abs()) & (a * e).simd_gt(f32x8::ZERO);
+        lo += m * m;
     }
-    to_mask(&pass) & used
-}
-
-#[inline]
-fn to_mask(pass: &[bool; LANES]) -> u32 {
-    let mut m = 0;
-    for (k, &p) in pass.iter().enumerate() {
-        m |= (p as u32) << k;
-    }
-    m
+    let rr = (f32x8::from(s.r) + f32x8::splat(rp) + f32x8::splat(slack)) * f32x8::splat(GROW);
+    lo.simd_le(rr * rr).to_bitmask() & used
 }
 
 /// Iterates over the set bits of a mask, lowest first.
