@@ -158,6 +158,8 @@ fn xyz3(v: &[[f32; LANES]; 3]) -> [&[f32; LANES]; 3] {
 type Scratch = (NodeCache<[[f32; LANES]; 3]>, Vec<Item>);
 
 thread_local! {
+    /// The leaf pairs of a query, copied out once at their final length.
+    static PAIRS: std::cell::RefCell<Vec<(u32, u32)>> = const { std::cell::RefCell::new(Vec::new()) };
     static CACHE: std::cell::RefCell<Scratch> =
         const { std::cell::RefCell::new((NodeCache::new(), Vec::new())) };
 }
@@ -169,13 +171,16 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
         DPose::from_pose(&b.motion.end),
     );
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
-    let mut pairs = Vec::new();
     let mut deepest: Option<(f32, usize, usize)> = None;
-    overlapping_leaves(ta, &pa, tb, &pb, |i, j, depth| {
-        pairs.push((i as u32, j as u32));
-        if deepest.is_none_or(|d| depth > d.0) {
-            deepest = Some((depth, i, j));
-        }
+    let pairs = PAIRS.with_borrow_mut(|pairs| {
+        pairs.clear();
+        overlapping_leaves(ta, &pa, tb, &pb, |i, j, depth| {
+            pairs.push((i as u32, j as u32));
+            if deepest.is_none_or(|d| depth > d.0) {
+                deepest = Some((depth, i, j));
+            }
+        });
+        pairs.to_vec()
     });
     let (_, i, j) = deepest?;
     let (ca, cb) = (
