@@ -183,6 +183,13 @@ impl<T: Copy + Default> NodeCache<T> {
         &self.values[i]
     }
 
+    /// The value of node `i`, already computed in this query.
+    #[inline]
+    pub(crate) fn cached(&self, i: usize) -> &T {
+        debug_assert_eq!(self.stamps[i], self.now);
+        &self.values[i]
+    }
+
     /// The value of node `i`, computed by `f` on first use in this query.
     #[inline]
     pub(crate) fn get(&mut self, i: usize, f: impl FnOnce() -> T) -> T {

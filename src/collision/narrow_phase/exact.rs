@@ -13,24 +13,28 @@
 //! only the leaf pairs whose swept spheres meet within it, so a long step does not drag every leaf
 //! pair of its whole sweep into the triangle stage.
 //!
-//! Advancement: from the earliest leaf time in the window, a lower bound d on
-//! the distance between the contact-capable parts (the surface inside each meeting leaf pair) is
-//! computed at the current poses: the exact distance between candidate triangles, visiting leaf
-//! pairs nearest first and skipping a leaf pair once its spheres are farther apart than the best
-//! distance so far (its in-sphere surface cannot be closer), and measuring a triangle pair only
-//! when neither the triangles' bounding spheres nor their planes (one triangle wholly beyond the
-//! other's plane, a lower bound that is nearly exact for the facing triangles of teeth in contact)
-//! already show it farther than the best; no point of the candidates
+//! Advancement: the candidate triangle pairs are listed once each (leaf pairs share triangles), in
+//! the order of their leaf pairs' distance at the start of the window. From the earliest leaf
+//! time, each step computes a lower bound d on the distance between the candidate triangles at the
+//! current poses: the exact distance of every candidate pair that three cheap lower bounds cannot
+//! already show farther than the best so far: the triangles' bounding spheres, their projections
+//! on the direction between the previous step's closest points (or between the nearest leaf
+//! pair's centres), and the plane gap (one triangle wholly beyond the other's plane, nearly exact
+//! for the facing triangles of teeth in contact). The previous step's nearest pair is measured
+//! first, so the best is small from the start and the bounds cull the rest. The minimum over all
+//! candidate pairs is a lower bound on the distance of whichever pair touches first (that pair
+//! is a candidate). No point of the candidates
 //! moves faster than μ = Σ (origin travel + rotation angle × farthest candidate vertex from the
 //! rotation axis) per unit time ([`Motion::speed_bound_of`]), so the gap cannot close before
 //! t + d/μ. Each
 //! step advances by (d − tolerance/2)/μ, leaving at least half the tolerance, and stops when
 //! d ≤ [`GAP_TOLERANCE_MM`]: the reported time is never after the first contact and the gap left
-//! there is within the tolerance. Between steps each triangle pair keeps its last distance: it
-//! cannot have shrunk by more than μ·Δt, so pairs whose carried bound exceeds the best distance of
-//! the step are not measured again (the minimum is unchanged, only cheaper). Teeth already
-//! interpenetrating at t = 0 report time 0 and the penetration depth of the whole meshes. After [`MAX_STEPS`] steps (slow convergence under large
-//! rotations) the current, still conservative, time is reported with its gap.
+//! there is within the tolerance. Between steps each candidate pair keeps its last distance (or
+//! lower bound): it cannot have shrunk by more than μ·Δt, so pairs whose carried bound exceeds
+//! the best distance of the step are not measured again (the minimum is unchanged, only cheaper).
+//! Teeth already interpenetrating at t = 0 report time 0 and the penetration depth of the whole
+//! meshes. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
+//! conservative, time is reported with its gap.
 //!
 //! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
 
@@ -71,6 +75,24 @@ impl PlacedTri {
             radius,
             plane: FacePlane::of(&v),
         }
+    }
+
+    /// A lower bound of the distance to `o`: how far apart the two triangles' projections on the
+    /// unit axis `n` lie (0 when they overlap), less the f32 rounding of the projections (each
+    /// within 5.2u·|v| of exact, u = 2⁻²⁴, and |v| ≤ |centre| + radius) and a relative 10⁻⁶ for
+    /// the difference and the axis length.
+    #[inline]
+    fn axis_gap(&self, o: &PlacedTri, n: Vec3) -> f32 {
+        let p = self.v.map(|v| n.dot(v));
+        let q = o.v.map(|v| n.dot(v));
+        let (p_lo, p_hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        let (q_lo, q_hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        let g = (q_lo - p_hi).max(p_lo - q_hi);
+        if g <= 0.0 {
+            return 0.0;
+        }
+        let margin = 4e-7 * (self.centre.length() + self.radius + o.centre.length() + o.radius);
+        (g - margin).max(0.0) * (1.0 - 1e-6)
     }
 
     /// A lower bound of the distance to `o`: the plane gap of [`crate::geometry::plane_gap`],
@@ -126,36 +148,36 @@ impl<'m> Placed<'m> {
     }
 }
 
-/// Per-thread scratch of the advancement: each mesh triangle's index among the candidates, and
-/// per candidate triangle pair its carried bound (see [`advance`]).
+/// Per-thread scratch of the advancement: each mesh triangle's index among the candidates, the
+/// triangle pairs already listed (one bit per pair of candidates) and the candidate pairs.
 struct Scratch {
     slot_a: NodeCache<u32>,
     slot_b: NodeCache<u32>,
-    seen: Vec<Seen>,
-    generation: u32,
+    listed: Vec<u64>,
+    candidates: Vec<Candidate>,
 }
 
-/// A candidate triangle pair's record: the query (generation) and step it was last looked at,
-/// and its last measured distance (or lower bound) with the time of it.
-#[derive(Clone, Copy, Default)]
-struct Seen {
-    generation: u32,
-    step: u32,
+/// A candidate triangle pair (indices among the candidate triangles of each side) and its last
+/// measured distance or lower bound `d` with the time `t` of it (−∞ before the first look).
+#[derive(Clone, Copy)]
+struct Candidate {
+    x: u32,
+    y: u32,
     d: f32,
     t: f64,
 }
 
-/// Candidate pair tables up to this many entries are kept per thread between queries; larger
-/// ones (scan-resolution teeth in deep contact) are allocated for the query.
-const KEEP_SEEN: usize = 1 << 18;
+/// Candidate lists up to this many entries (and listed-pair bit sets up to this many words) are
+/// kept per thread between queries.
+const KEEP_CANDIDATES: usize = 1 << 16;
 
 thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = const {
         std::cell::RefCell::new(Scratch {
             slot_a: NodeCache::new(),
             slot_b: NodeCache::new(),
-            seen: Vec::new(),
-            generation: 0,
+            listed: Vec::new(),
+            candidates: Vec::new(),
         })
     };
 }
@@ -218,7 +240,17 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
 /// Conservative advancement over the bodies' whole motion, from the earliest meeting leaf time of
 /// `swept` (which must list every meeting leaf pair).
 fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact) -> Option<PairContact> {
-    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, scratch))
+    SCRATCH.with_borrow_mut(|scratch| {
+        let contact = advance_with(a, b, swept, scratch);
+        // Scan-resolution teeth in deep contact list millions of pairs: their lists are not kept.
+        if scratch.candidates.capacity() > KEEP_CANDIDATES {
+            scratch.candidates = Vec::new();
+        }
+        if scratch.listed.capacity() > KEEP_CANDIDATES {
+            scratch.listed = Vec::new();
+        }
+        contact
+    })
 }
 
 fn advance_with(
@@ -229,138 +261,145 @@ fn advance_with(
 ) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let (ma, mb) = (&a.shape.geometry.mesh, &b.shape.geometry.mesh);
-    // Candidate triangles of each side (ids_a / ids_b) and, per leaf pair, its triangle pairs
-    // as indices into them (a flat list with one range per leaf pair).
     let Scratch {
         slot_a,
         slot_b,
-        seen,
-        generation,
+        listed,
+        candidates,
     } = scratch;
+    let mut t = swept
+        .leaf_times
+        .iter()
+        .map(|x| x.2)
+        .fold(f64::INFINITY, f64::min);
+    // Leaf pairs nearest first at the start, so that the first triangle pairs measured are near
+    // ones and the bounds cull the rest.
+    let start_rel = relative(&a.motion, &b.motion, t).2;
+    let mut order: Vec<(f32, usize)> = swept
+        .leaf_times
+        .iter()
+        .enumerate()
+        .map(|(k, &(i, j, _))| {
+            let (sa, sb) = (ta.spheres[i as usize], tb.spheres[j as usize]);
+            let gap = sa.centre.distance(start_rel.apply(sb.centre)) - sa.radius - sb.radius;
+            (gap, k)
+        })
+        .collect();
+    order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    // Candidate triangles of each side (ids_a / ids_b), numbered in order of first use.
     slot_a.begin(ma.triangles.len());
     slot_b.begin(mb.triangles.len());
-    let mut ids_a: Vec<u32> = Vec::new();
-    let mut ids_b: Vec<u32> = Vec::new();
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    let mut leaf_pairs: Vec<(u32, u32, std::ops::Range<usize>)> =
-        Vec::with_capacity(swept.leaf_times.len());
-    let mut local_b: Vec<u32> = Vec::new();
-    for &(i, j, _) in &swept.leaf_times {
-        local_b.clear();
-        for &y in &tb.triangles[j as usize] {
-            local_b.push(slot_b.get(y as usize, || {
-                ids_b.push(y);
-                ids_b.len() as u32 - 1
-            }));
-        }
-        let first = pairs.len();
-        for &x in &ta.triangles[i as usize] {
-            let xi = slot_a.get(x as usize, || {
+    let (mut ids_a, mut ids_b) = (Vec::new(), Vec::new());
+    let mut leaves: Vec<(&[u32], &[u32])> = Vec::with_capacity(order.len());
+    for &(_, k) in &order {
+        let (i, j, _) = swept.leaf_times[k];
+        let (xs, ys) = (&ta.triangles[i as usize], &tb.triangles[j as usize]);
+        for &x in xs {
+            slot_a.get(x as usize, || {
                 ids_a.push(x);
                 ids_a.len() as u32 - 1
             });
-            pairs.extend(local_b.iter().map(|&yi| (xi, yi)));
         }
-        leaf_pairs.push((i, j, first..pairs.len()));
+        for &y in ys {
+            slot_b.get(y as usize, || {
+                ids_b.push(y);
+                ids_b.len() as u32 - 1
+            });
+        }
+        leaves.push((xs, ys));
+    }
+    // Candidate triangle pairs, each once (leaf pairs share triangles), in the leaves' order.
+    let ny = ids_b.len();
+    let words = (ids_a.len() * ny).div_ceil(64);
+    if listed.len() < words {
+        listed.resize(words, 0);
+    }
+    listed[..words].fill(0);
+    candidates.clear();
+    for (xs, ys) in leaves {
+        for &x in xs {
+            let xi = *slot_a.cached(x as usize);
+            for &y in ys {
+                let yi = *slot_b.cached(y as usize);
+                let key = xi as usize * ny + yi as usize;
+                let (word, bit) = (key / 64, 1u64 << (key % 64));
+                if listed[word] & bit == 0 {
+                    listed[word] |= bit;
+                    candidates.push(Candidate {
+                        x: xi,
+                        y: yi,
+                        d: f32::NEG_INFINITY,
+                        t,
+                    });
+                }
+            }
+        }
     }
     let speed = |motion: &Motion, mesh: &crate::geometry::TriMesh, ids: &[u32]| {
         motion.speed_bound_of(ids.iter().flat_map(|&t| mesh.triangle(t as usize)))
     };
     let mu = (speed(&a.motion, ma, &ids_a) + speed(&b.motion, mb, &ids_b)) * (1.0 + 1e-6);
     let tol = GAP_TOLERANCE_MM as f64;
-    let mut t = swept
-        .leaf_times
-        .iter()
-        .map(|x| x.2)
-        .fold(f64::INFINITY, f64::min);
-    let ny = ids_b.len();
-    let table = ids_a.len() * ny;
     let mut pa = Placed::new(ma, ids_a);
     let mut pb = Placed::new(mb, ids_b);
-    let mut order: Vec<(f32, usize)> = Vec::with_capacity(leaf_pairs.len());
-    // Per triangle pair (leaf pairs share triangles): the step it was last looked at, and its
-    // last measured distance (or lower bound) with the time of it: no pair's distance shrinks
-    // faster than μ, so d − μ·(t − t_then) bounds it now and pairs that cannot beat the best
-    // are skipped. Small tables live on in the thread's scratch, told apart by generation.
-    let mut own: Vec<Seen>;
-    let seen: &mut [Seen] = if table <= KEEP_SEEN {
-        if seen.len() < table {
-            seen.resize(table, Seen::default());
-        }
-        *generation = generation.wrapping_add(1);
-        if *generation == 0 {
-            seen.iter_mut().for_each(|s| s.generation = 0);
-            *generation = 1;
-        }
-        &mut seen[..table]
-    } else {
-        *generation = generation.wrapping_add(1).max(1);
-        own = vec![Seen::default(); table];
-        &mut own
-    };
-    let now = *generation;
-    let mut step = 0u32;
+    // The nearest pair of the previous step, measured first in the next, and the direction
+    // between its closest points (a's frame): projections on it bound most pairs near the contact.
+    // Before the first step, the direction between the nearest leaf pair's centres.
+    let mut nearest: Option<usize> = None;
+    let mut axis = order.first().map_or(Vec3::X, |&(_, k)| {
+        let (i, j, _) = swept.leaf_times[k];
+        let (sa, sb) = (ta.spheres[i as usize], tb.spheres[j as usize]);
+        (start_rel.apply(sb.centre) - sa.centre).normalize_or(Vec3::X)
+    });
     for round in 0..=MAX_STEPS {
-        let (pose_a, pose_b) = (a.motion.at(t as f32), b.motion.at(t as f32));
         // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
-        let (da, db) = (DPose::from_pose(&pose_a), DPose::from_pose(&pose_b));
-        let inv = da.rotation.inverse();
-        let rel = Affine32::new(inv * db.rotation, inv * (db.translation - da.translation));
+        let (pose_a, pose_b, rel) = relative(&a.motion, &b.motion, t);
         pb.now += 1;
-        // Leaf pairs nearest first: a pair whose spheres are farther apart than the best distance
-        // found cannot hold a closer contact-capable pair (see the module doc).
-        order.clear();
-        for (k, (i, j, _)) in leaf_pairs.iter().enumerate() {
-            let (sa, sb) = (ta.spheres[*i as usize], tb.spheres[*j as usize]);
-            let gap = sa.centre.distance(rel.apply(sb.centre)) - sa.radius - sb.radius;
-            order.push((gap, k));
-        }
-        order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-        step += 1;
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
-        for &(gap, k) in &order {
-            if gap >= best.0 {
-                break;
+        let mut best_k = None;
+        // No pair's distance shrinks faster than μ, so its last distance d, measured at t₀,
+        // bounds it now by d − μ·(t − t₀): pairs that cannot beat the best are not measured.
+        let mut look = |k: usize, c: &mut Candidate| {
+            if c.d as f64 - mu * (t - c.t) - LIPSCHITZ_SLACK_MM >= best.0 as f64 {
+                return;
             }
-            for &(x, y) in &pairs[leaf_pairs[k].2.clone()] {
-                let key = x as usize * ny + y as usize;
-                let record = &mut seen[key];
-                if record.generation == now {
-                    if record.step == step {
-                        continue;
-                    }
-                    if record.d as f64 - mu * (t - record.t) - LIPSCHITZ_SLACK_MM >= best.0 as f64 {
-                        record.step = step;
-                        continue;
-                    }
-                }
-                *record = Seen {
-                    generation: now,
-                    step,
-                    d: f32::INFINITY,
-                    t,
-                };
-                let tx = *pa.get(x as usize, None);
-                let ty = pb.get(y as usize, Some(&rel));
-                let spheres = tx.centre.distance(ty.centre) - tx.radius - ty.radius;
-                if spheres >= best.0 {
-                    record.d = spheres.max(0.0);
-                    continue;
-                }
-                // Facing triangles: the plane gap is nearly the distance and far cheaper.
-                let lb = tx.gap_to(ty);
-                if lb >= best.0 {
-                    record.d = lb;
-                    continue;
-                }
-                let p = closest_points_triangle_triangle(&tx.v, &ty.v);
-                record.d = p.distance;
-                if p.distance < best.0 {
-                    best = (p.distance, p.on_first, p.on_second);
-                }
+            c.t = t;
+            let tx = *pa.get(c.x as usize, None);
+            let ty = pb.get(c.y as usize, Some(&rel));
+            let spheres = tx.centre.distance(ty.centre) - tx.radius - ty.radius;
+            if spheres >= best.0 {
+                c.d = spheres.max(0.0);
+                return;
+            }
+            let lb = tx.axis_gap(ty, axis);
+            if lb >= best.0 {
+                c.d = lb;
+                return;
+            }
+            // Facing triangles: the plane gap is nearly the distance and far cheaper.
+            let lb = tx.gap_to(ty);
+            if lb >= best.0 {
+                c.d = lb;
+                return;
+            }
+            let p = closest_points_triangle_triangle(&tx.v, &ty.v);
+            c.d = p.distance;
+            if p.distance < best.0 {
+                best = (p.distance, p.on_first, p.on_second);
+                best_k = Some(k);
+            }
+        };
+        if let Some(k) = nearest {
+            look(k, &mut candidates[k]);
+        }
+        for (k, c) in candidates.iter_mut().enumerate() {
+            if Some(k) != nearest {
+                look(k, c);
             }
         }
+        nearest = best_k;
         let (d, qa, qb) = best;
+        axis = (qb - qa).normalize_or(axis);
         if !d.is_finite() {
             return None;
         }
@@ -376,8 +415,8 @@ fn advance_with(
                 leaf_pairs: swept.contact.leaf_pairs.clone(),
             };
             if d == 0.0 {
-                // Touching or interpenetrating (only possible at the start): measure the depth.
-                // The candidates already touch: only the depth is left to find.
+                // Touching or interpenetrating (only possible at the start): the candidates
+                // already touch, so only the depth is left to find.
                 let (depth, pa, pb) = mesh_penetration(
                     MeshRef {
                         mesh: ma,
@@ -409,4 +448,17 @@ fn advance_with(
         }
     }
     None
+}
+
+/// Both poses at time `t` and the second tooth's map into the first's frame, pose_a⁻¹ ∘ pose_b.
+fn relative(
+    a: &Motion,
+    b: &Motion,
+    t: f64,
+) -> (crate::geometry::Pose, crate::geometry::Pose, Affine32) {
+    let (pose_a, pose_b) = (a.at(t as f32), b.at(t as f32));
+    let (da, db) = (DPose::from_pose(&pose_a), DPose::from_pose(&pose_b));
+    let inv = da.rotation.inverse();
+    let rel = Affine32::new(inv * db.rotation, inv * (db.translation - da.translation));
+    (pose_a, pose_b, rel)
 }
