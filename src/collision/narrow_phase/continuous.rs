@@ -308,6 +308,10 @@ fn descend(
 pub fn query(a: &Body, b: &Body, all_pairs: bool) -> Option<SweptContact> {
     let mut leaf_times = Vec::new();
     swept_leaves(a, b, !all_pairs, |i, j, t| {
+        // One allocation for the usual few dozen pairs, none for a query without any.
+        if leaf_times.is_empty() {
+            leaf_times.reserve(32);
+        }
         leaf_times.push((i as u32, j as u32, t))
     });
     let &(i, j, t) = leaf_times
