@@ -53,8 +53,11 @@ pub struct CompactTree {
     pub first: Vec<u32>,
     /// Number of children (0 for a leaf).
     pub count: Vec<u32>,
-    /// Triangles each leaf touches (empty for inner nodes).
-    pub triangles: Vec<Vec<u32>>,
+    /// Triangles each leaf touches, all leaves' lists in one array (node order): node i's list is
+    /// `triangle_list[triangle_start[i]..triangle_start[i + 1]]` (see [`Self::triangles`]).
+    triangle_list: Vec<u32>,
+    /// Start of each node's list in `triangle_list`, and one past the last.
+    triangle_start: Vec<u32>,
     /// Sibling groups in lanes: chunk 0 holds the root alone, then each inner node's children.
     pub chunks: Vec<Chunk>,
     /// Per node, the range of chunks holding its children (empty for a leaf).
@@ -70,7 +73,8 @@ impl CompactTree {
             spheres: Vec::new(),
             first: Vec::new(),
             count: Vec::new(),
-            triangles: Vec::new(),
+            triangle_list: Vec::new(),
+            triangle_start: vec![0],
             chunks: Vec::new(),
             child_chunks: Vec::new(),
             max_rho: 0.0,
@@ -90,11 +94,10 @@ impl CompactTree {
             out.first.push(next);
             out.count.push(kids.len() as u32);
             next += kids.len() as u32;
-            out.triangles.push(if kids.is_empty() {
-                tree.triangles[n].clone()
-            } else {
-                Vec::new()
-            });
+            if kids.is_empty() {
+                out.triangle_list.extend_from_slice(&tree.triangles[n]);
+            }
+            out.triangle_start.push(out.triangle_list.len() as u32);
             for c in kids {
                 out.spheres.push(tree.nodes[c].expect("filtered above"));
                 queue.push_back(c);
@@ -143,6 +146,12 @@ impl CompactTree {
             }
             self.child_chunks.push(start..self.chunks.len() as u32);
         }
+    }
+
+    /// The triangles leaf `i` touches (none for an inner node).
+    #[inline]
+    pub fn triangles(&self, i: usize) -> &[u32] {
+        &self.triangle_list[self.triangle_start[i] as usize..self.triangle_start[i + 1] as usize]
     }
 
     /// True when node `i` has no children.

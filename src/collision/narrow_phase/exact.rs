@@ -261,7 +261,7 @@ fn advance_with(
     let mut leaves: Vec<(&[u32], &[u32])> = Vec::with_capacity(order.len());
     for &(_, k) in &order {
         let (i, j, _) = swept.leaf_times[k];
-        let (xs, ys) = (&ta.triangles[i as usize], &tb.triangles[j as usize]);
+        let (xs, ys) = (ta.triangles(i as usize), tb.triangles(j as usize));
         for &x in xs {
             slot_a.get(x as usize, || {
                 ids_a.push(x);
