@@ -341,55 +341,15 @@ pub fn mesh_penetration(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) ->
 
 /// The deepest sample point of `a` (vertices and triangle centroids) inside `b`: its depth, the point
 /// (world) and the nearest point of b's surface (world).
-///
-/// Only the triangles of `a` whose boxes meet b's box (mapped into a's frame, grown by far more
-/// than the rounding of either map) are sampled: no other sample point can lie in b's box, so the
-/// result is that of sampling every point, in the same order.
 fn deepest_point(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, Vec3, Vec3) {
     let a_in_b = pose_b.inverse().mul(pose_a);
-    let b_in_a = pose_a.inverse().mul(pose_b);
     let b_box = b.bvh.root_aabb();
-    let mut best = (0.0f32, pose_a.translation, pose_a.translation);
-    if a.bvh.nodes.is_empty() || b.bvh.nodes.is_empty() {
-        return best;
-    }
-    let near = {
-        let m = b_box.transformed(&Mat3::from_quat(b_in_a.rotation), b_in_a.translation);
-        let pad = 1e-3 + 1e-5 * (m.min.abs().max(m.max.abs()).max_element());
-        Aabb {
-            min: m.min - Vec3::splat(pad),
-            max: m.max + Vec3::splat(pad),
-        }
-    };
-    let mut triangles: Vec<u32> = Vec::new();
-    let mut stack = vec![0u32];
-    while let Some(n) = stack.pop() {
-        let node = a.bvh.nodes[n as usize];
-        if node.aabb.distance_squared(&near) > 0.0 {
-            continue;
-        }
-        if node.is_leaf() {
-            triangles.extend_from_slice(a.bvh.leaf_triangles(&node));
-        } else {
-            stack.extend([node.start, node.start + 1]);
-        }
-    }
-    triangles.sort_unstable();
-    let mut vertices: Vec<u32> = triangles
-        .iter()
-        .flat_map(|&t| a.mesh.triangles[t as usize])
-        .collect();
-    vertices.sort_unstable();
-    vertices.dedup();
-    let centroids = triangles.iter().map(|&i| {
-        let [p, q, r] = a.mesh.triangle(i as usize);
+    let centroids = (0..a.mesh.triangles.len()).map(|i| {
+        let [p, q, r] = a.mesh.triangle(i);
         (p + q + r) / 3.0
     });
-    let samples = vertices
-        .iter()
-        .map(|&v| a.mesh.vertices[v as usize])
-        .chain(centroids);
-    for local in samples {
+    let mut best = (0.0f32, pose_a.translation, pose_a.translation);
+    for local in a.mesh.vertices.iter().copied().chain(centroids) {
         let p = a_in_b.transform_point(local);
         if b_box.distance_squared_to_point(p) > 0.0 || !point_inside_mesh(b, p) {
             continue;
