@@ -506,11 +506,7 @@ mod tests {
         let t3 = tri([5.0, 0.0, -1.0], [5.0, 0.0, 1.0], [6.0, 0.0, 0.0]);
         assert_eq!(triangle_plane_gap(&t1, &t3), 0.0);
         // Random pairs: never above the exact distance.
-        let mut state = 99u32;
-        let mut rnd = || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
+        let mut rnd = crate::geometry::test_numbers(99);
         for _ in 0..5000 {
             let mut v = || Vec3::new(rnd(), rnd(), rnd()) * 4.0;
             let (a, b) = ([v(), v(), v()], [v(), v(), v()]);
@@ -521,11 +517,7 @@ mod tests {
 
     #[test]
     fn the_fast_triangle_distance_agrees_with_the_exhaustive_one() {
-        let mut state = 12345u32;
-        let mut rnd = || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
+        let mut rnd = crate::geometry::test_numbers(12345);
         let mut by_kind = [0usize; 3];
         for n in 0..40_000 {
             let mut v = |s: f32| Vec3::new(rnd(), rnd(), rnd()) * s;

@@ -28,3 +28,14 @@ pub use mesh_distance::{MeshRef, MeshSeparation, mesh_penetration, mesh_separati
 pub use pose::Pose;
 pub use sphere::Sphere;
 pub use trimesh::{MeshError, TriMesh};
+
+/// The geometry tests' seeded source of uniform numbers in [−0.5, 0.5) (a linear congruential
+/// generator: small, fixed, and the same sequence on every machine).
+#[cfg(test)]
+pub(crate) fn test_numbers(seed: u32) -> impl FnMut() -> f32 {
+    let mut state = seed;
+    move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    }
+}

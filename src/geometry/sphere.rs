@@ -185,11 +185,7 @@ mod tests {
 
     #[test]
     fn enclosing_sphere_contains_every_point_and_is_small() {
-        let mut state = 7u32;
-        let mut rnd = || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
+        let mut rnd = crate::geometry::test_numbers(7);
         for n in [1usize, 2, 5, 50, 2000] {
             let pts: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(rnd(), rnd() * 3.0, rnd()) * 4.0)

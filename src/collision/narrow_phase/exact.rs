@@ -242,7 +242,7 @@ fn advance_with(
         .fold(f64::INFINITY, f64::min);
     // Leaf pairs nearest first at the start, so that the first triangle pairs measured are near
     // ones and the bounds cull the rest.
-    let start_rel = relative(&a.motion, &b.motion, t).2;
+    let start_rel = relative(&a.motion, &b.motion, t).rel;
     let mut order: Vec<(f32, usize)> = swept
         .leaf_times
         .iter()
@@ -330,7 +330,12 @@ fn advance_with(
     });
     for round in 0..=MAX_STEPS {
         // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
-        let (pose_a, pose_b, rel) = relative(&a.motion, &b.motion, t);
+        let Frame {
+            pose_a,
+            pose_b,
+            to_a,
+            rel,
+        } = relative(&a.motion, &b.motion, t);
         tris_b.clear();
         tris_b.extend(ids_b.iter().map(|&y| place(mb, y, Some(&rel))));
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
@@ -425,7 +430,7 @@ fn advance_with(
         let h = 0.5 * tol;
         let plain = (d - h) / mu;
         let mut step = plain;
-        if let (Some(k), Some(drift)) = (nearest, motions.drift(t, &pose_a, axis, &rel)) {
+        if let (Some(k), Some(drift)) = (nearest, motions.drift(t, to_a, axis, &rel)) {
             let c = &candidates[k];
             let first = drift.step(&tris_a[c.x as usize], &tris_b[c.y as usize]);
             step = first.min(1.0 - t).max(plain);
@@ -500,17 +505,11 @@ impl Relative {
         }
     }
 
-    /// The drift along the unit `n` (first tooth's frame) at time `t`, with the first tooth's pose
-    /// and the second's map into its frame then; `None` when nothing useful can be said.
-    fn drift(
-        &self,
-        t: f64,
-        pose_a: &crate::geometry::Pose,
-        n: Vec3,
-        rel: &Affine32,
-    ) -> Option<Drift> {
-        let inv = DPose::from_pose(pose_a).rotation.inverse();
-        let (u, w, omega) = (inv * self.v, inv * self.omega_b, inv * self.omega_a);
+    /// The drift along the unit `n` (first tooth's frame) at time `t`, with the first tooth's
+    /// inverse rotation and the second's map into its frame then; `None` when nothing useful can
+    /// be said.
+    fn drift(&self, t: f64, to_a: glam::DQuat, n: Vec3, rel: &Affine32) -> Option<Drift> {
+        let (u, w, omega) = (to_a * self.v, to_a * self.omega_b, to_a * self.omega_a);
         let o = rel.t.as_dvec3();
         let nd = n.as_dvec3();
         let c0 = nd.dot(u) - o.dot(nd.cross(w));
@@ -548,10 +547,10 @@ impl Drift {
         let n = self.n;
         let p = x.v.map(|v| n.dot(v) as f64);
         let q = y.v.map(|v| n.dot(v) as f64);
-        let speed = y.v.map(|v| self.c0 + v.as_dvec3().dot(self.m));
-        let keep = 0.5 * GAP_TOLERANCE_MM as f64 + self.margin;
         let (p_lo, p_hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
         let (q_lo, q_hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        let speed = y.v.map(|v| self.c0 + v.as_dvec3().dot(self.m));
+        let keep = 0.5 * GAP_TOLERANCE_MM as f64 + self.margin;
         let (s_lo, s_hi) = (
             speed[0].min(speed[1]).min(speed[2]),
             speed[0].max(speed[1]).max(speed[2]),
@@ -561,10 +560,11 @@ impl Drift {
         let side = |gap: f64, s: f64| {
             // The positive root of AΔ²/2 − sΔ − e, written without cancellation.
             let e = gap - keep;
-            let root = (s * s + 2.0 * self.accel * e).sqrt();
             if e <= 0.0 {
-                0.0
-            } else if s < 0.0 {
+                return 0.0;
+            }
+            let root = (s * s + 2.0 * self.accel * e).sqrt();
+            if s < 0.0 {
                 2.0 * e / (root - s)
             } else if self.accel > 0.0 {
                 (s + root) / self.accel
@@ -576,53 +576,53 @@ impl Drift {
     }
 }
 
-/// Both poses at time `t` and the second tooth's map into the first's frame, pose_a⁻¹ ∘ pose_b.
-fn relative(
-    a: &Motion,
-    b: &Motion,
-    t: f64,
-) -> (crate::geometry::Pose, crate::geometry::Pose, Affine32) {
+/// Both teeth at one time, seen from the first tooth.
+struct Frame {
+    pose_a: crate::geometry::Pose,
+    pose_b: crate::geometry::Pose,
+    /// The first tooth's rotation, inverted (world to its frame).
+    to_a: glam::DQuat,
+    /// The second tooth's map into the first's frame, pose_a⁻¹ ∘ pose_b.
+    rel: Affine32,
+}
+
+/// Both teeth at time `t`.
+fn relative(a: &Motion, b: &Motion, t: f64) -> Frame {
     let (pose_a, pose_b) = (a.at(t as f32), b.at(t as f32));
     let (da, db) = (DPose::from_pose(&pose_a), DPose::from_pose(&pose_b));
-    let inv = da.rotation.inverse();
-    let rel = Affine32::new(inv * db.rotation, inv * (db.translation - da.translation));
-    (pose_a, pose_b, rel)
+    let to_a = da.rotation.inverse();
+    let rel = Affine32::new(to_a * db.rotation, to_a * (db.translation - da.translation));
+    Frame {
+        pose_a,
+        pose_b,
+        to_a,
+        rel,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Pose;
+    use crate::{collision::bench::Rng, geometry::Pose};
     use glam::Quat;
 
-    struct Rng(u64);
-
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn vec(&mut self, scale: f32) -> Vec3 {
-            Vec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * 2.0 * scale
-        }
-        fn motion(&mut self, degrees: f32, mm: f32) -> Motion {
-            let rotation = Quat::from_axis_angle(self.vec(1.0).normalize(), 3.0 * self.next());
-            let start = Pose::new(rotation, self.vec(5.0));
-            let turn = Quat::from_axis_angle(self.vec(1.0).normalize(), degrees.to_radians());
-            Motion {
-                start,
-                end: Pose::new(
-                    (turn * rotation).normalize(),
-                    start.translation + self.vec(mm),
-                ),
-            }
+    /// A motion from a random pose, turned by `degrees` about a random axis and shifted by up to
+    /// `mm` per axis.
+    fn motion(rng: &mut Rng, degrees: f32, mm: f32) -> Motion {
+        let rotation = Quat::from_axis_angle(rng.unit(), 3.0 * rng.uniform());
+        let start = Pose::new(rotation, rng.vec(5.0));
+        let turn = Quat::from_axis_angle(rng.unit(), degrees.to_radians());
+        Motion {
+            start,
+            end: Pose::new(
+                (turn * rotation).normalize(),
+                start.translation + rng.vec(mm),
+            ),
         }
     }
 
     /// The directional step never lets two triangles come closer along the direction than half
-    /// the tolerance: checked against the poses the motions really produce, at 64 times within
+    /// the tolerance: checked against the poses the motions really produce, at 65 times within
     /// each step, for rotations up to 15° and steps up to 5 mm of both teeth.
     #[test]
     fn directional_steps_keep_half_the_tolerance() {
@@ -634,10 +634,10 @@ mod tests {
             } else {
                 (15.0, 5.0)
             };
-            let degrees = degrees * rng.next();
-            let (ma, mb) = (rng.motion(degrees, mm), rng.motion(degrees, mm));
-            let t0 = 0.9 * rng.next() as f64;
-            let (pose_a, _, rel) = relative(&ma, &mb, t0);
+            let degrees = degrees * rng.uniform();
+            let (ma, mb) = (motion(&mut rng, degrees, mm), motion(&mut rng, degrees, mm));
+            let t0 = 0.9 * rng.uniform() as f64;
+            let Frame { to_a, rel, .. } = relative(&ma, &mb, t0);
             let x = [rng.vec(8.0), rng.vec(8.0), rng.vec(8.0)];
             let y_local = [rng.vec(8.0), rng.vec(8.0), rng.vec(8.0)];
             let rho_b = y_local.iter().map(|v| v.length()).fold(0.0f32, f32::max) as f64;
@@ -646,7 +646,7 @@ mod tests {
                 PlacedTri::new(y_local.map(|v| rel.apply(v))),
             );
             let n = (ty.centre - tx.centre).normalize();
-            let Some(drift) = Relative::new(&ma, &mb, rho_b).drift(t0, &pose_a, n, &rel) else {
+            let Some(drift) = Relative::new(&ma, &mb, rho_b).drift(t0, to_a, n, &rel) else {
                 continue;
             };
             let step = drift.step(&tx, &ty).min(1.0 - t0);
