@@ -12,22 +12,30 @@
 //! 3. **Candidates.** Each medial ball grown by a geometric series of margins (fractions of s). A
 //!    candidate covers the pieces whose three corners it holds and is shrunk to the farthest of
 //!    them; its cost is its volume outside the tooth, by exact line integrals over a lattice
-//!    ([`Columns`]). A tiny sphere around each piece no candidate covers, and the smallest sphere
-//!    around the whole mesh, keep the cover always feasible.
-//! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ),
-//!    gains updated as pieces are covered), then spheres whose pieces others cover are dropped. The
+//!    ([`Columns`], all margins of a ball in one pass over the lines). A tiny sphere around each
+//!    piece no candidate covers, and the smallest sphere around the whole mesh, keep the cover
+//!    always feasible.
+//! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ)),
+//!    evaluated lazily: gains only fall as pieces are covered, so a heap of stale gains is an upper
+//!    bound and only its top is re-measured. Then spheres whose pieces others cover are dropped. The
 //!    sum of the costs is the paper's `sov_sum` (times the tooth volume) plus λ per leaf; λ is
-//!    searched so that the leaves just fit the budget B^(levels−1).
+//!    searched (from a guess scaled from the λ = 0 cover, then on log λ against log size) so that
+//!    the cover just fits 8 % over the budget B^(levels−1): polishing leaves a few spheres with no
+//!    surface of their own, and step 6 drops any leaves still over the budget.
 //! 5. **Shrink and polish.** The cover is decided on pieces; the spheres are then tightened on a
 //!    lattice of 15 points per piece: each point goes to the sphere that holds it with the most
 //!    room, each sphere shrinks to its points (radii only shrink, so the points stay covered), and
 //!    each sphere's centre is moved by a pattern search that lowers its outside volume while it
-//!    holds its points (the farthest point found over lanes of eight). One shrinking round, then
-//!    five rounds of polish and shrink.
+//!    holds its points (the farthest point found over lanes of eight). A piece whose three corners
+//!    go to one sphere goes to it whole, without testing its inner points: the sphere holds its
+//!    corners, so the whole piece, whose farthest point from the centre is a corner. One shrinking
+//!    round, then five rounds of polish and shrink; after the first, a sphere's search starts
+//!    at twice the largest step that moved it the round before.
 //! 6. **Exact cover.** Every triangle is split as the coverage check splits it until each piece
 //!    lies in one sphere (the one with the most room); a piece no sphere holds after five splits —
 //!    a sliver between the points — grows the sphere that needs the least growth. Each sphere then
-//!    shrinks to the pieces it is responsible for.
+//!    shrinks to the pieces it is responsible for. If more leaves than the budget hold pieces, the
+//!    ones holding the fewest go and the exact cover is made again without them.
 //! 7. **Hierarchy.** Leaves are split into B balanced groups along the longest axis of their
 //!    centres, recursively; each inner sphere is the smallest sphere around the pieces its leaves
 //!    are responsible for, so invariant (2) holds by construction.
@@ -38,11 +46,12 @@
 //! Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
-//! 0.077 (0.059–0.100), about 482 leaves; see the README for the table and the build times.
+//! 0.074 (0.057–0.094), about 510 leaves; see the README for the table and the build times.
 
 use std::{cmp::Ordering, collections::BinaryHeap};
 
 use glam::Vec3;
+use wide::f32x8;
 
 use super::{
     coverage::split4,
@@ -76,8 +85,17 @@ const POINT_LATTICE: u32 = 4;
 const SHRINK_ROUNDS: u32 = 1;
 /// Rounds of centre polishing, each followed by a shrinking round.
 const POLISH_ROUNDS: u32 = 5;
-/// Lattice lines across the tooth for outside volumes.
+/// Lattice lines across the tooth for outside volumes while polishing.
 const LINES: usize = 64;
+/// The same for the candidates' costs, which only rank candidates against each other.
+const CANDIDATE_LINES: usize = 48;
+/// The cover aims this much over the leaf budget: a few spheres lose all their surface to
+/// neighbours while polishing, and any still over the budget at the end are dropped.
+const COVER_OVERSHOOT: f32 = 1.08;
+/// First pattern-search step of the polish, as a fraction of the radius; later rounds start at
+/// twice the largest step that moved the sphere last time, but not below `LEAST_FIRST_STEP`.
+const FIRST_STEP: f32 = 0.12;
+const LEAST_FIRST_STEP: f32 = 0.04;
 /// Radius rounding so that f32 containment agrees with the distances used here.
 const MARGIN_REL: f32 = 1e-6;
 const MARGIN_ABS: f32 = 1e-5;
@@ -286,6 +304,7 @@ fn candidates(
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); growth.len()];
     let mut radii = Vec::with_capacity(growth.len());
     let mut costs = vec![0.0f64; growth.len()];
+    let mut far = vec![0.0f32; growth.len()];
     for &k in seeds {
         let ball = medial_ball(m, pieces.centroid[k], pieces.normal[k], start);
         let r_max = ball.radius + growth[growth.len() - 1] * s;
@@ -295,18 +314,29 @@ fn candidates(
         for b in buckets.iter_mut() {
             b.clear();
         }
-        let mut far = vec![0.0f32; growth.len()];
+        // Squared distances throughout: the reach of a piece is its farthest corner.
+        let limit2: Vec<f32> = growth
+            .iter()
+            .map(|&g| (ball.radius + g * s).powi(2))
+            .collect();
+        let r_max2 = r_max * r_max;
+        far.iter_mut().for_each(|f| *f = 0.0);
         for &i in &near {
-            let r = reach(&pieces.corners[i as usize], ball.centre);
-            if r > r_max {
+            let r2 = pieces.corners[i as usize]
+                .iter()
+                .map(|p| p.distance_squared(ball.centre))
+                .fold(0.0f32, f32::max);
+            if r2 > r_max2 {
                 continue;
             }
-            let b = growth
+            // The first step that reaches the piece (counted without branches).
+            let b = limit2
                 .iter()
-                .position(|&g| r <= ball.radius + g * s)
-                .unwrap_or(growth.len() - 1);
+                .map(|&l| (r2 > l) as usize)
+                .sum::<usize>()
+                .min(growth.len() - 1);
             buckets[b].push(i);
-            far[b] = far[b].max(r);
+            far[b] = far[b].max(r2);
         }
         // Distinct covers, each shrunk to its farthest piece.
         radii.clear();
@@ -318,7 +348,7 @@ fn candidates(
                 continue;
             }
             out.pool.extend_from_slice(bucket);
-            reach_so_far = reach_so_far.max(far[b]);
+            reach_so_far = reach_so_far.max(far[b].sqrt());
             prefixes.push(out.pool.len() - first as usize);
             radii.push(padded(reach_so_far));
         }
@@ -362,9 +392,9 @@ fn candidates(
     out
 }
 
-/// Heap entry: priority, candidate, the candidate's version when the priority was computed.
+/// Heap entry: priority (an upper bound on the candidate's key), candidate.
 #[derive(PartialEq)]
-struct Entry(f64, u32, u32);
+struct Entry(f64, u32);
 impl Eq for Entry {}
 impl PartialOrd for Entry {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
@@ -378,82 +408,51 @@ impl Ord for Entry {
     }
 }
 
-/// For each piece, the candidates that cover it (the transpose of the candidates' pools).
-struct Covers {
-    start: Vec<u32>,
-    items: Vec<u32>,
+/// A piece's weight in the cover: its area, and a little for a degenerate piece so that it still
+/// counts as something to cover.
+fn piece_weight(area: f32) -> f64 {
+    (area as f64).max(f64::MIN_POSITIVE)
 }
 
-impl Covers {
-    fn new(c: &Candidates, pieces: usize) -> Self {
-        let mut start = vec![0u32; pieces + 1];
-        for x in &c.list {
-            for &i in &c.pool[x.first as usize..(x.first + x.len) as usize] {
-                start[i as usize + 1] += 1;
-            }
-        }
-        for i in 1..start.len() {
-            start[i] += start[i - 1];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; start[pieces] as usize];
-        for (k, x) in c.list.iter().enumerate() {
-            for &i in &c.pool[x.first as usize..(x.first + x.len) as usize] {
-                items[fill[i as usize] as usize] = k as u32;
-                fill[i as usize] += 1;
-            }
-        }
-        Self { start, items }
-    }
-
-    fn of(&self, piece: u32) -> &[u32] {
-        &self.items[self.start[piece as usize] as usize..self.start[piece as usize + 1] as usize]
-    }
-}
-
-/// Greedy weighted set cover (newly covered area per (cost + λ)), with gains kept up to date as
-/// pieces are covered; returns the chosen candidates in order.
-fn greedy(
-    c: &Candidates,
-    covers: &Covers,
-    area: &[f32],
-    initial_gain: &[f64],
-    lambda: f64,
-) -> Vec<u32> {
-    let mut gain = initial_gain.to_vec();
-    let mut left: Vec<u32> = c.list.iter().map(|x| x.len).collect();
-    let mut version = vec![0u32; c.list.len()];
+/// Greedy weighted set cover: repeatedly the candidate with the most newly covered area per
+/// (cost + λ), ties to the lower index; returns the chosen candidates in order.
+///
+/// Lazy evaluation (Minoux's accelerated greedy): a candidate's gain only falls as pieces are
+/// covered, so the heap holds upper bounds; the top is re-measured, and taken when its true key
+/// still beats the next bound, which makes it the true best without updating every candidate that
+/// shares a newly covered piece.
+fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Vec<u32> {
     let key = |k: usize, gain: f64| gain / (c.list[k].cost + lambda).max(1e-12);
     let mut heap: BinaryHeap<Entry> = (0..c.list.len())
-        .map(|k| Entry(key(k, gain[k]), k as u32, 0))
+        .filter(|&k| c.list[k].len > 0)
+        .map(|k| Entry(key(k, initial_gain[k]), k as u32))
         .collect();
-    let mut covered = vec![false; area.len()];
+    // The area each piece would still add (zero once covered).
+    let mut open: Vec<f64> = area.iter().map(|&a| piece_weight(a)).collect();
     let mut uncovered = area.len();
     let mut chosen = Vec::new();
+    let members = |k: usize| {
+        let x = &c.list[k];
+        &c.pool[x.first as usize..(x.first + x.len) as usize]
+    };
     while uncovered > 0 {
-        let Some(Entry(_, k, v)) = heap.pop() else {
+        let Some(Entry(_, k)) = heap.pop() else {
             break;
         };
         let k = k as usize;
-        if left[k] == 0 {
+        let gain: f64 = members(k).iter().map(|&i| open[i as usize]).sum();
+        if gain == 0.0 {
             continue;
         }
-        if v != version[k] {
-            heap.push(Entry(key(k, gain[k]), k as u32, version[k]));
+        let entry = Entry(key(k, gain), k as u32);
+        if heap.peek().is_some_and(|top| *top > entry) {
+            heap.push(entry);
             continue;
         }
-        let x = &c.list[k];
-        for &i in &c.pool[x.first as usize..(x.first + x.len) as usize] {
-            if covered[i as usize] {
-                continue;
-            }
-            covered[i as usize] = true;
-            uncovered -= 1;
-            for &other in covers.of(i) {
-                let o = other as usize;
-                gain[o] -= area[i as usize] as f64;
-                left[o] -= 1;
-                version[o] += 1;
+        for &i in members(k) {
+            if open[i as usize] > 0.0 {
+                open[i as usize] = 0.0;
+                uncovered -= 1;
             }
         }
         chosen.push(k as u32);
@@ -462,12 +461,12 @@ fn greedy(
 }
 
 /// The greedy cover, pruned, with a per-leaf cost λ that brings its size just under the budget:
-/// λ = 0 if that fits, else a search on log λ against log size (interpolating between the
-/// tightest bracket, which converges in a few runs since the size falls roughly as a power of λ),
-/// stopping once a cover uses at least 97 % of the budget.
+/// λ = 0 if that fits, else a search on log λ against log size. The first guess scales the λ = 0
+/// cover's mean cost by (its size / target)^1.6; later ones follow the size as a power of λ
+/// (exponent about −1/2, measured on teeth) until a bracket is found, then interpolate within the
+/// tightest bracket. It stops once a cover uses at least 97 % of the budget.
 fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
-    let covers = Covers::new(c, area.len());
     // Each candidate's area: the same for every run.
     let initial_gain: Vec<f64> = c
         .list
@@ -475,12 +474,12 @@ fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
         .map(|x| {
             c.pool[x.first as usize..(x.first + x.len) as usize]
                 .iter()
-                .map(|&i| area[i as usize] as f64)
+                .map(|&i| piece_weight(area[i as usize]))
                 .sum()
         })
         .collect();
     let run = |lambda: f64| {
-        let mut chosen = greedy(c, &covers, area, &initial_gain, lambda);
+        let mut chosen = greedy(c, area, &initial_gain, lambda);
         prune(c, &mut chosen, area.len());
         chosen
     };
@@ -495,7 +494,7 @@ fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     let mut over: (f64, f64) = (0.0, first.len() as f64);
     let mut under: Option<(f64, f64)> = None;
     let mut best: Vec<u32> = Vec::new();
-    let mut lambda = mean_cost.max(1e-12);
+    let mut lambda = (mean_cost * (first.len() as f64 / target).powf(1.6)).max(1e-12);
     for _ in 0..RUNS {
         let chosen = run(lambda);
         let n = chosen.len() as f64;
@@ -517,8 +516,8 @@ fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
                 let t = (over.1.ln() - target.ln()) / (over.1.ln() - u.1.ln()).max(1e-9);
                 (over.0.ln() + t.clamp(0.05, 0.95) * (u.0.ln() - over.0.ln())).exp()
             }
-            Some(u) => u.0 * (u.1 / target).powf(1.5),
-            None => over.0 * (over.1 / target).powf(1.5),
+            Some(u) => u.0 * (u.1 / target).powf(2.0),
+            None => over.0 * (over.1 / target).powf(2.0),
         };
     }
     if best.is_empty() {
@@ -608,8 +607,19 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
             seeds.push(i);
         }
     }
-    let cands = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
-    let chosen = choose(&cands, &pieces.area, max_leaves);
+    let cands = candidates(
+        m,
+        &pieces,
+        &Columns::build(mesh, CANDIDATE_LINES),
+        &seeds,
+        s,
+        max_leaves,
+    );
+    let chosen = choose(
+        &cands,
+        &pieces.area,
+        (max_leaves as f32 * COVER_OVERSHOOT) as usize,
+    );
     let mut spheres: Vec<Sphere> = chosen
         .iter()
         .map(|&k| cands.list[k as usize].sphere)
@@ -625,29 +635,62 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
     }
     let (mut points, mut point_owner) = (Vec::new(), Vec::new());
     let n = POINT_LATTICE;
-    for (i, &[a, b, c]) in pieces.corners.iter().enumerate() {
-        for u in 0..=n {
-            for v in 0..=n - u {
-                let (fu, fv) = (u as f32 / n as f32, v as f32 / n as f32);
-                points.push(a + (b - a) * fu + (c - a) * fv);
-                point_owner.push(owner[i]);
-            }
-        }
+    let lattice = Lattice::new(n);
+    for (i, &corners) in pieces.corners.iter().enumerate() {
+        Lattice::points_on(n, corners, &mut points);
+        point_owner.resize(points.len(), owner[i]);
     }
-    shrink(&mut spheres, &points, &mut point_owner, SHRINK_ROUNDS, s);
+    shrink(
+        &mut spheres,
+        &points,
+        &mut point_owner,
+        lattice,
+        SHRINK_ROUNDS,
+        s,
+    );
+    let mut steps = vec![FIRST_STEP; spheres.len()];
     for _ in 0..POLISH_ROUNDS {
+        // A piece owned whole is represented by its corners (its farthest points from any centre).
         let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
-        for (p, &o) in points.iter().zip(&point_owner) {
-            owned[o as usize].push(*p);
-        }
-        for (sphere, points) in spheres.iter_mut().zip(&owned) {
-            if !points.is_empty() {
-                *sphere = polish(&columns, *sphere, points);
+        for (piece, own) in points
+            .chunks(lattice.len)
+            .zip(point_owner.chunks(lattice.len))
+        {
+            if own.iter().all(|&o| o == own[0]) {
+                owned[own[0] as usize].extend(lattice.corners.map(|k| piece[k]));
+            } else {
+                for (p, &o) in piece.iter().zip(own) {
+                    owned[o as usize].push(*p);
+                }
             }
         }
-        shrink(&mut spheres, &points, &mut point_owner, 1, s);
+        for ((sphere, points), step) in spheres.iter_mut().zip(&owned).zip(&mut steps) {
+            if !points.is_empty() {
+                let (polished, moved) = polish(&columns, *sphere, points, *step);
+                *sphere = polished;
+                *step = (2.0 * moved / sphere.radius).clamp(LEAST_FIRST_STEP, FIRST_STEP);
+            }
+        }
+        shrink(&mut spheres, &points, &mut point_owner, lattice, 1, s);
     }
-    let (leaves, corners) = cover_exact(spheres, &pieces.corners, s);
+    let (mut leaves, mut corners) = cover_exact(spheres, &pieces.corners, s);
+    if leaves.len() > max_leaves {
+        // Over the budget: the leaves holding the fewest pieces go, and the others take their
+        // pieces over (growing where they must).
+        let mut order: Vec<usize> = (0..leaves.len()).collect();
+        order.sort_by_key(|&k| (corners[k].len(), k));
+        let mut keep = vec![true; leaves.len()];
+        for &k in &order[..leaves.len() - max_leaves] {
+            keep[k] = false;
+        }
+        let kept: Vec<Sphere> = leaves
+            .iter()
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(s, _)| *s)
+            .collect();
+        (leaves, corners) = cover_exact(kept, &pieces.corners, s);
+    }
     let order: Vec<usize> = (0..leaves.len()).collect();
     place(&mut tree, 0, 0, order, &leaves, &corners, mesh);
     tree
@@ -711,36 +754,174 @@ impl SphereGrid {
     }
 }
 
-/// Shrinks the spheres: each point goes to the sphere that holds it with the most room (least
-/// distance / radius) and every sphere shrinks to its own points, `rounds` times. Radii never grow,
-/// so every point stays inside the sphere it belongs to.
-fn shrink(spheres: &mut [Sphere], pts: &[Vec3], owner: &mut [u32], rounds: u32, cell: f32) {
-    let grid = SphereGrid::new(spheres, cell);
-    let mut dist = vec![0.0f32; pts.len()];
-    for _ in 0..rounds.max(1) {
-        for (i, &p) in pts.iter().enumerate() {
-            let own = owner[i] as usize;
-            let d = p.distance(spheres[own].centre);
-            let mut best = (own as u32, d / spheres[own].radius, d);
-            for &k in grid.near(p) {
-                let s = &spheres[k as usize];
-                if k as usize == own || !s.contains(p) {
-                    continue;
+/// Eight spheres of a grid cell, by coordinate (padding lanes hold nothing: r² = −1).
+#[derive(Clone, Copy)]
+struct SphereLanes {
+    x: f32x8,
+    y: f32x8,
+    z: f32x8,
+    r2: f32x8,
+    inv_r2: f32x8,
+    index: [u32; 8],
+}
+
+/// A [`SphereGrid`]'s cells as runs of [`SphereLanes`].
+struct LaneGrid {
+    start: Vec<u32>,
+    lanes: Vec<SphereLanes>,
+}
+
+impl LaneGrid {
+    fn new(grid: &SphereGrid, spheres: &[Sphere]) -> Self {
+        let mut start = Vec::with_capacity(grid.cells.len() + 1);
+        let mut lanes = Vec::new();
+        for cell in &grid.cells {
+            start.push(lanes.len() as u32);
+            for chunk in cell.chunks(8) {
+                let mut l = [[0.0f32; 8]; 5];
+                l[3] = [-1.0; 8];
+                let mut index = [u32::MAX; 8];
+                for (k, &i) in chunk.iter().enumerate() {
+                    let s = &spheres[i as usize];
+                    (l[0][k], l[1][k], l[2][k]) = (s.centre.x, s.centre.y, s.centre.z);
+                    l[3][k] = s.radius * s.radius;
+                    l[4][k] = 1.0 / l[3][k];
+                    index[k] = i;
                 }
-                let d = p.distance(s.centre);
-                if d / s.radius < best.1 {
-                    best = (k, d / s.radius, d);
+                lanes.push(SphereLanes {
+                    x: l[0].into(),
+                    y: l[1].into(),
+                    z: l[2].into(),
+                    r2: l[3].into(),
+                    inv_r2: l[4].into(),
+                    index,
+                });
+            }
+        }
+        start.push(lanes.len() as u32);
+        Self { start, lanes }
+    }
+
+    /// Sets each sphere's r² (and its inverse) to the current radius.
+    fn update(&mut self, spheres: &[Sphere]) {
+        for l in &mut self.lanes {
+            let mut r2 = l.r2.to_array();
+            for (k, &i) in l.index.iter().enumerate() {
+                if i != u32::MAX {
+                    let r = spheres[i as usize].radius;
+                    r2[k] = r * r;
                 }
             }
-            owner[i] = best.0;
-            dist[i] = best.2;
+            l.r2 = r2.into();
+            l.inv_r2 = f32x8::ONE / l.r2;
         }
-        let mut radius = vec![0.0f32; spheres.len()];
-        for (i, &o) in owner.iter().enumerate() {
-            radius[o as usize] = radius[o as usize].max(dist[i]);
+    }
+
+    fn near(&self, grid: &SphereGrid, p: Vec3) -> &[SphereLanes] {
+        let [x, y, z] = grid.cell_of(p);
+        let cell = (x * grid.dims[1] + y) * grid.dims[2] + z;
+        &self.lanes[self.start[cell] as usize..self.start[cell + 1] as usize]
+    }
+}
+
+/// Shrinks the spheres: each point goes to the sphere that holds it with the most room (least
+/// distance / radius, compared as squares) and every sphere shrinks to its own points, `rounds`
+/// times. Radii never grow, so every point stays inside the sphere it belongs to.
+///
+/// Points come in runs of `lattice.len` per piece with the piece's corners at `lattice.corners`.
+/// A piece whose three corners go to one sphere goes to it whole: the sphere holds the corners, so
+/// (being convex) the whole piece, and its farthest point from the centre is a corner.
+fn shrink(
+    spheres: &mut [Sphere],
+    pts: &[Vec3],
+    owner: &mut [u32],
+    lattice: Lattice,
+    rounds: u32,
+    cell: f32,
+) {
+    let grid = SphereGrid::new(spheres, cell);
+    let mut lanes = LaneGrid::new(&grid, spheres);
+    let mut radius = vec![0.0f32; spheres.len()];
+    for round in 0..rounds.max(1) {
+        if round > 0 {
+            lanes.update(spheres);
         }
-        for (s, &r) in spheres.iter_mut().zip(&radius) {
-            s.radius = padded(r).min(s.radius);
+        radius.iter_mut().for_each(|r| *r = 0.0);
+        let best_of = |p: Vec3, own: usize| {
+            let d2 = p.distance_squared(spheres[own].centre);
+            let r = spheres[own].radius;
+            let mut best = (own as u32, d2 / (r * r), d2);
+            let (px, py, pz) = (f32x8::splat(p.x), f32x8::splat(p.y), f32x8::splat(p.z));
+            for l in lanes.near(&grid, p) {
+                let (dx, dy, dz) = (l.x - px, l.y - py, l.z - pz);
+                let d2 = dx * dx + dy * dy + dz * dz;
+                let ratio = d2 * l.inv_r2;
+                let better = d2.simd_le(l.r2) & ratio.simd_lt(f32x8::splat(best.1));
+                let mut mask = better.to_bitmask();
+                if mask == 0 {
+                    continue;
+                }
+                let (ratio, d2) = (ratio.to_array(), d2.to_array());
+                while mask != 0 {
+                    let k = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if ratio[k] < best.1 {
+                        best = (l.index[k], ratio[k], d2[k]);
+                    }
+                }
+            }
+            best
+        };
+        for (piece, own) in pts.chunks(lattice.len).zip(owner.chunks_mut(lattice.len)) {
+            let corners = lattice.corners.map(|k| best_of(piece[k], own[k] as usize));
+            if corners.iter().all(|c| c.0 == corners[0].0) {
+                let k = corners[0].0;
+                own.iter_mut().for_each(|o| *o = k);
+                let r = &mut radius[k as usize];
+                *r = corners.iter().map(|c| c.2).fold(*r, f32::max);
+                continue;
+            }
+            for (j, (&p, o)) in piece.iter().zip(own.iter_mut()).enumerate() {
+                let best = match lattice.corners.iter().position(|&c| c == j) {
+                    Some(c) => corners[c],
+                    None => best_of(p, *o as usize),
+                };
+                *o = best.0;
+                let r = &mut radius[best.0 as usize];
+                *r = r.max(best.2);
+            }
+        }
+        for (s, &r2) in spheres.iter_mut().zip(&radius) {
+            s.radius = padded(r2.sqrt()).min(s.radius);
+        }
+    }
+}
+
+/// The lattice of points on each piece: how many, and which are the corners.
+#[derive(Clone, Copy)]
+struct Lattice {
+    len: usize,
+    corners: [usize; 3],
+}
+
+impl Lattice {
+    /// n + 1 points per edge, in the order `points_on` writes them.
+    fn new(n: u32) -> Self {
+        let n = n.max(1) as usize;
+        Self {
+            len: (n + 1) * (n + 2) / 2,
+            corners: [0, (n + 1) * (n + 2) / 2 - 1, n],
+        }
+    }
+
+    /// The lattice points of a piece: a + (b − a)·u/n + (c − a)·v/n for u + v ≤ n, u major.
+    fn points_on(n: u32, [a, b, c]: [Vec3; 3], out: &mut Vec<Vec3>) {
+        let n = n.max(1);
+        for u in 0..=n {
+            for v in 0..=n - u {
+                let (fu, fv) = (u as f32 / n as f32, v as f32 / n as f32);
+                out.push(a + (b - a) * fu + (c - a) * fv);
+            }
         }
     }
 }
@@ -826,7 +1007,7 @@ fn dedup(points: &mut Vec<Vec3>) {
 /// Moves a leaf's centre to lower its outside volume while it keeps holding `points`: a compass
 /// pattern search (steps from a quarter of the radius down to 2 %, at most 40 trials), the radius
 /// following the farthest point.
-fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
+fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3], first_step: f32) -> (Sphere, f32) {
     // Points relative to the starting centre, in lanes of eight: the farthest point from a trial
     // centre is a max over squared distances that the compiler vectorises.
     let o = leaf.centre;
@@ -861,7 +1042,8 @@ fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
         (columns.outside_volume(&s), s)
     };
     let (mut best_cost, mut best) = fit(leaf.centre);
-    let mut step = 0.25 * leaf.radius;
+    let mut step = first_step * leaf.radius;
+    let mut largest = 0.0f32;
     let dirs = [
         Vec3::X,
         Vec3::NEG_X,
@@ -879,6 +1061,7 @@ fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
             if cost < best_cost {
                 (best_cost, best) = (cost, s);
                 moved = true;
+                largest = largest.max(step);
                 break;
             }
         }
@@ -886,7 +1069,7 @@ fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3]) -> Sphere {
             step *= 0.5;
         }
     }
-    best
+    (best, largest)
 }
 
 /// Places `group` (leaf indices) at slot `node` of `level`: a single leaf sits in the slot itself;
