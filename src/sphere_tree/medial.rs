@@ -343,10 +343,12 @@ fn candidates(
         let mut prefixes = Vec::new();
         let first = out.pool.len() as u32;
         let mut reach_so_far = 0.0f32;
-        for (b, bucket) in buckets.iter().enumerate() {
+        for (b, bucket) in buckets.iter_mut().enumerate() {
             if bucket.is_empty() {
                 continue;
             }
+            // In index order, so that the cover reads the pieces' state in memory order.
+            bucket.sort_unstable();
             out.pool.extend_from_slice(bucket);
             reach_so_far = reach_so_far.max(far[b].sqrt());
             prefixes.push(out.pool.len() - first as usize);
@@ -1053,15 +1055,19 @@ fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3], first_step: f32) -> 
         Vec3::NEG_Z,
     ];
     let mut evals = 0;
+    // The direction that last lowered the cost is tried first.
+    let mut first = 0;
     while step > 0.02 * leaf.radius && evals < 40 {
         let mut moved = false;
-        for d in dirs {
-            let (cost, s) = fit(best.centre + d * step);
+        for t in 0..dirs.len() {
+            let k = (first + t) % dirs.len();
+            let (cost, s) = fit(best.centre + dirs[k] * step);
             evals += 1;
             if cost < best_cost {
                 (best_cost, best) = (cost, s);
                 moved = true;
                 largest = largest.max(step);
+                first = k;
                 break;
             }
         }
