@@ -190,6 +190,9 @@ struct PieceGrid {
     dims: [usize; 3],
     start: Vec<u32>,
     items: Vec<u32>,
+    /// The pieces' corner coordinates in `items` order (corner-major: x, y, z of the first
+    /// corner, then the second, the third), padded with eight zeros, for lane-wise reading.
+    corners: [Vec<f32>; 9],
 }
 
 impl PieceGrid {
@@ -225,31 +228,66 @@ impl PieceGrid {
             items[*slot as usize] = k as u32;
             *slot += 1;
         }
+        let corners = std::array::from_fn(|c| {
+            let mut v: Vec<f32> = items
+                .iter()
+                .map(|&k| pieces.corners[k as usize][c / 3][c % 3])
+                .collect();
+            v.resize(items.len() + 8, 0.0);
+            v
+        });
         Self {
             min: bounds.min,
             cell,
             dims,
             start: count,
             items,
+            corners,
         }
     }
 
-    /// Pieces whose centroid may lie within `r` of `c`.
-    fn near(&self, c: Vec3, r: f32, out: &mut Vec<u32>) {
-        out.clear();
+    /// Calls `f(piece, reach²)` for every piece whose three corners lie within `r` of `c`
+    /// (reach = distance to the farthest corner), eight pieces at a time.
+    fn within(&self, c: Vec3, r: f32, mut f: impl FnMut(u32, f32)) {
         let lo = ((c - Vec3::splat(r) - self.min) / self.cell).floor();
         let hi = ((c + Vec3::splat(r) - self.min) / self.cell).floor();
         let clamp = |x: f32, d: usize| (x.max(0.0) as usize).min(d - 1);
         if hi.x < 0.0 || hi.y < 0.0 || hi.z < 0.0 {
             return;
         }
+        let r2 = f32x8::splat(r * r);
+        let centre = [c.x, c.y, c.z].map(f32x8::splat);
+        let lane = f32x8::from(std::array::from_fn::<f32, 8, _>(|k| k as f32));
+        let load = |v: &[f32], j: usize| f32x8::from(<[f32; 8]>::try_from(&v[j..j + 8]).unwrap());
         for x in clamp(lo.x, self.dims[0])..=clamp(hi.x, self.dims[0]) {
             for y in clamp(lo.y, self.dims[1])..=clamp(hi.y, self.dims[1]) {
-                for z in clamp(lo.z, self.dims[2])..=clamp(hi.z, self.dims[2]) {
-                    let cell = (x * self.dims[1] + y) * self.dims[2] + z;
-                    out.extend_from_slice(
-                        &self.items[self.start[cell] as usize..self.start[cell + 1] as usize],
-                    );
+                let row = (x * self.dims[1] + y) * self.dims[2];
+                let (z0, z1) = (clamp(lo.z, self.dims[2]), clamp(hi.z, self.dims[2]));
+                // Cells along z are consecutive in `items`.
+                let (a, b) = (
+                    self.start[row + z0] as usize,
+                    self.start[row + z1 + 1] as usize,
+                );
+                let mut j = a;
+                while j < b {
+                    let mut reach = f32x8::ZERO;
+                    for corner in 0..3 {
+                        let d =
+                            |axis: usize| load(&self.corners[corner * 3 + axis], j) - centre[axis];
+                        let (dx, dy, dz) = (d(0), d(1), d(2));
+                        reach = reach.max(dx * dx + dy * dy + dz * dz);
+                    }
+                    let valid = lane.simd_lt(f32x8::splat((b - j) as f32));
+                    let mut mask = (reach.simd_le(r2) & valid).to_bitmask();
+                    if mask != 0 {
+                        let reach = reach.to_array();
+                        while mask != 0 {
+                            let k = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            f(self.items[j + k], reach[k]);
+                        }
+                    }
+                    j += 8;
                 }
             }
         }
@@ -293,7 +331,6 @@ fn candidates(
         list: Vec::new(),
         pool: Vec::new(),
     };
-    let mut near = Vec::new();
     let growth: &[f32] = if max_leaves < 64 {
         &GROWTH_WIDE
     } else if max_leaves < 512 {
@@ -308,27 +345,17 @@ fn candidates(
     for &k in seeds {
         let ball = medial_ball(m, pieces.centroid[k], pieces.normal[k], start);
         let r_max = ball.radius + growth[growth.len() - 1] * s;
-        grid.near(ball.centre, r_max, &mut near);
         // Pieces bucketed by the first growth step that reaches them (no sort needed: a
-        // candidate covers whole buckets).
+        // candidate covers whole buckets); squared distances throughout.
         for b in buckets.iter_mut() {
             b.clear();
         }
-        // Squared distances throughout: the reach of a piece is its farthest corner.
         let limit2: Vec<f32> = growth
             .iter()
             .map(|&g| (ball.radius + g * s).powi(2))
             .collect();
-        let r_max2 = r_max * r_max;
         far.iter_mut().for_each(|f| *f = 0.0);
-        for &i in &near {
-            let r2 = pieces.corners[i as usize]
-                .iter()
-                .map(|p| p.distance_squared(ball.centre))
-                .fold(0.0f32, f32::max);
-            if r2 > r_max2 {
-                continue;
-            }
+        grid.within(ball.centre, r_max, |i, r2| {
             // The first step that reaches the piece (counted without branches).
             let b = limit2
                 .iter()
@@ -337,7 +364,7 @@ fn candidates(
                 .min(growth.len() - 1);
             buckets[b].push(i);
             far[b] = far[b].max(r2);
-        }
+        });
         // Distinct covers, each shrunk to its farthest piece.
         radii.clear();
         let mut prefixes = Vec::new();
@@ -412,8 +439,8 @@ impl Ord for Entry {
 
 /// A piece's weight in the cover: its area, and a little for a degenerate piece so that it still
 /// counts as something to cover.
-fn piece_weight(area: f32) -> f64 {
-    (area as f64).max(f64::MIN_POSITIVE)
+fn piece_weight(area: f32) -> f32 {
+    area.max(f32::MIN_POSITIVE)
 }
 
 /// Greedy weighted set cover: repeatedly the candidate with the most newly covered area per
@@ -429,8 +456,8 @@ fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Ve
         .filter(|&k| c.list[k].len > 0)
         .map(|k| Entry(key(k, initial_gain[k]), k as u32))
         .collect();
-    // The area each piece would still add (zero once covered).
-    let mut open: Vec<f64> = area.iter().map(|&a| piece_weight(a)).collect();
+    // The area each piece would still add (zero once covered), in f32 to halve the memory read.
+    let mut open: Vec<f32> = area.iter().map(|&a| piece_weight(a)).collect();
     let mut uncovered = area.len();
     let mut chosen = Vec::new();
     let members = |k: usize| {
@@ -442,7 +469,7 @@ fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Ve
             break;
         };
         let k = k as usize;
-        let gain: f64 = members(k).iter().map(|&i| open[i as usize]).sum();
+        let gain = members(k).iter().map(|&i| open[i as usize]).sum::<f32>() as f64;
         if gain == 0.0 {
             continue;
         }
@@ -470,6 +497,8 @@ fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Ve
 fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
     // Each candidate's area: the same for every run.
+    // Summed in f32 in member order, as the cover re-measures it: a float sum never grows when
+    // a term is replaced by zero, so these stay upper bounds.
     let initial_gain: Vec<f64> = c
         .list
         .iter()
@@ -477,7 +506,7 @@ fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
             c.pool[x.first as usize..(x.first + x.len) as usize]
                 .iter()
                 .map(|&i| piece_weight(area[i as usize]))
-                .sum()
+                .sum::<f32>() as f64
         })
         .collect();
     let run = |lambda: f64| {
