@@ -33,7 +33,9 @@
 //! points approach along the normal or the meshes overlap deeper at the end of the step than at
 //! its start; with `continuous` when the deepest overlap of leaf spheres grows over the step (leaf
 //! spheres of neighbours overlap at rest, and some pair of them approaches under almost any
-//! motion); with the discrete methods when an overlapping leaf pair (or the circles) got closer. With `circles`, pairs of opposite
+//! motion); with `spheres` likewise when the deepest overlap of leaf spheres at the end of the step
+//! is deeper than at its start (a step into a new overlap always blocks); with `circles` when the
+//! circles got closer. With `circles`, pairs of opposite
 //! arches never block: the paper's circles ignore height and would lock every tooth against its
 //! antagonist.
 //!
@@ -716,7 +718,7 @@ impl Simulation {
 
     /// For a contact already touching at the start: whether the overlap is deeper at the end of
     /// the step than at its start (exact: the meshes overlap at the end more than at the start;
-    /// continuous: the deepest overlap of leaf spheres grows). This catches what the contact
+    /// continuous and spheres: the deepest overlap of leaf spheres grows, or appears). This catches what the contact
     /// points' velocities miss under rotation: other parts of the surfaces closing in.
     fn deepens(&self, f: &Found) -> bool {
         let (ta, tb) = (&self.teeth[f.a], &self.teeth[f.b]);
@@ -732,7 +734,7 @@ impl Simulation {
                 .signed_gap();
                 end < 0.0 && end < -f.contact.depth_mm - 1e-6
             }
-            Method::Continuous => {
+            Method::Continuous | Method::Spheres => {
                 let depth = |pairs: &[(u32, u32)], pa: &Pose, pb: &Pose| {
                     pairs
                         .iter()
@@ -763,7 +765,7 @@ impl Simulation {
                     });
                 depth(&end.leaf_pairs, &ma.end, &mb.end) > start + 1e-6
             }
-            Method::Circles | Method::Spheres => false,
+            Method::Circles => false,
         }
     }
 
@@ -777,7 +779,10 @@ impl Simulation {
             return (self.ipr_over.contains(&(f.a, f.b)) && self.closing(f, 0.0)).then_some(0.0);
         }
         match self.method {
-            Method::Circles | Method::Spheres => self.closing(f, 1.0).then_some(0.0),
+            Method::Circles => self.closing(f, 1.0).then_some(0.0),
+            // Leaf spheres of neighbours overlap at rest and some pair of them approaches under
+            // almost any motion, so, as for `continuous`, only a deepening overlap blocks.
+            Method::Spheres => self.deepens(f).then_some(0.0),
             Method::Continuous | Method::Exact => {
                 let t = f.contact.time_of_contact;
                 if t >= 1.0 - TIME_SLACK {

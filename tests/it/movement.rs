@@ -113,7 +113,7 @@ fn check_case(case: &str, method: Method, moves: &[u8], stays: &[u8]) -> CaseRun
 
 #[test]
 fn case1_moves_first_molars_and_second_premolars_not_incisors() {
-    for method in [Method::Continuous, Method::Exact] {
+    for method in [Method::Spheres, Method::Continuous, Method::Exact] {
         let r = check_case(
             "case1",
             method,
@@ -137,9 +137,36 @@ fn case1_moves_first_molars_and_second_premolars_not_incisors() {
     }
 }
 
+/// At the default step the leaf spheres of resting neighbours overlap over many pairs, and some
+/// pair approaches under almost any motion; only a deepening overlap may block, or the first
+/// molars would stay against their distal neighbours.
+#[test]
+fn spheres_move_the_first_molars_at_the_default_step() {
+    let r = run_case(
+        "case1",
+        Method::Spheres,
+        MovementSettings::default(),
+        medial(),
+        Some(cache()),
+        10_000,
+        |_| {},
+    )
+    .unwrap();
+    let rep = &r.report;
+    assert!(rep.at_rest, "{rep:?}");
+    for f in fdis(&[16, 26, 36, 46, 15, 25, 35, 45]) {
+        assert!(rep.moved.contains(&f), "{f} should move: {rep:?}");
+    }
+    for (a, b) in [(15, 13), (23, 25), (45, 43), (33, 35)] {
+        let g = gap(&r, a, b);
+        assert!(g <= 0.5, "{a}-{b} gap {g}");
+    }
+    assert!(rep.max_penetration_mm <= 0.05, "{rep:?}");
+}
+
 #[test]
 fn case2_moves_first_molars_and_first_premolars_not_canines() {
-    for method in [Method::Continuous, Method::Exact] {
+    for method in [Method::Spheres, Method::Continuous, Method::Exact] {
         let r = check_case(
             "case2",
             method,
@@ -156,7 +183,11 @@ fn case2_moves_first_molars_and_first_premolars_not_canines() {
 
 #[test]
 fn case3_closes_the_diastemas() {
-    for (method, limit) in [(Method::Exact, 0.011), (Method::Continuous, 0.15)] {
+    for (method, limit) in [
+        (Method::Exact, 0.011),
+        (Method::Continuous, 0.15),
+        (Method::Spheres, 0.15),
+    ] {
         let r = check_case("case3", method, &[11, 21, 31, 41], &[13, 23, 33, 43]);
         for (a, b) in [(11, 21), (41, 31)] {
             let g = gap(&r, a, b);
