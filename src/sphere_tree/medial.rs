@@ -1175,6 +1175,77 @@ mod tests {
         sphere_tree::{check_coverage, coverage::DEFAULT_SPLIT_DEPTH},
     };
 
+    /// The lazy cover picks what the plain greedy picks: at every turn the candidate with the
+    /// most newly covered area per (cost + λ), ties to the lower index.
+    #[test]
+    fn lazy_cover_picks_what_the_plain_greedy_picks() {
+        let mut rng = crate::geometry::test_numbers(7);
+        let pieces = 300;
+        let area: Vec<f32> = (0..pieces).map(|_| rng() + 0.6).collect();
+        let mut c = Candidates {
+            list: Vec::new(),
+            pool: Vec::new(),
+        };
+        for k in 0..400 {
+            let first = c.pool.len() as u32;
+            let len = ((rng() + 0.5) * 30.0) as u32 + 1;
+            let mut members: Vec<u32> = (0..len)
+                .map(|_| ((rng() + 0.5) * pieces as f32) as u32 % pieces as u32)
+                .collect();
+            members.sort_unstable();
+            members.dedup();
+            c.pool.extend(&members);
+            c.list.push(Candidate {
+                sphere: Sphere::new(Vec3::ZERO, 1.0),
+                first,
+                len: members.len() as u32,
+                cost: ((rng() + 0.5) * 3.0) as f64 * (k % 3) as f64,
+            });
+        }
+        // Everything coverable: one candidate per piece.
+        for i in 0..pieces as u32 {
+            c.list.push(Candidate {
+                sphere: Sphere::new(Vec3::ZERO, 1.0),
+                first: c.pool.len() as u32,
+                len: 1,
+                cost: 5.0,
+            });
+            c.pool.push(i);
+        }
+        let members = |k: usize| {
+            let x = &c.list[k];
+            &c.pool[x.first as usize..(x.first + x.len) as usize]
+        };
+        let initial: Vec<f64> = (0..c.list.len())
+            .map(|k| {
+                members(k)
+                    .iter()
+                    .map(|&i| piece_weight(area[i as usize]))
+                    .sum::<f32>() as f64
+            })
+            .collect();
+        for lambda in [0.0, 0.3, 4.0] {
+            let lazy = greedy(&c, &area, &initial, lambda);
+            let mut open: Vec<f32> = area.iter().map(|&a| piece_weight(a)).collect();
+            let mut plain = Vec::new();
+            while open.iter().any(|&a| a > 0.0) {
+                let key = |k: usize| {
+                    let gain = members(k).iter().map(|&i| open[i as usize]).sum::<f32>() as f64;
+                    gain / (c.list[k].cost + lambda).max(1e-12)
+                };
+                let best = (0..c.list.len())
+                    .max_by(|&a, &b| key(a).total_cmp(&key(b)).then(b.cmp(&a)))
+                    .unwrap();
+                for &i in members(best) {
+                    open[i as usize] = 0.0;
+                }
+                plain.push(best as u32);
+            }
+            assert_eq!(lazy, plain, "λ {lambda}");
+            assert!(lazy.len() > 10);
+        }
+    }
+
     #[test]
     fn medial_trees_cover_and_stay_within_the_budget() {
         let mesh = cuboid(Vec3::ZERO, Vec3::new(6.0, 3.0, 2.0));
