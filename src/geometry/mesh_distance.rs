@@ -156,12 +156,14 @@ fn to_world(p: TrianglePair, pose: &Pose) -> TrianglePair {
 pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
     let mut best: Option<(Vec3, f32)> = None;
     let mut best_d2 = f32::INFINITY;
-    let mut stack = vec![0u32];
     if m.bvh.nodes.is_empty() {
         return None;
     }
-    while let Some(n) = stack.pop() {
-        let node = m.bvh.nodes[n as usize];
+    // Depth-first, at most one pending sibling per level of a balanced tree (see `ray_parity`).
+    let (mut stack, mut top) = ([0u32; 64], 1);
+    while top > 0 {
+        top -= 1;
+        let node = m.bvh.nodes[stack[top] as usize];
         if node.aabb.distance_squared_to_point(p) > best_d2 {
             continue;
         }
@@ -183,11 +185,10 @@ pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
                     .aabb
                     .distance_squared_to_point(p),
             );
-            if d0 < d1 {
-                stack.extend([l + 1, l]);
-            } else {
-                stack.extend([l, l + 1]);
-            }
+            let (near, far) = if d0 < d1 { (l, l + 1) } else { (l + 1, l) };
+            stack[top] = far;
+            stack[top + 1] = near;
+            top += 2;
         }
     }
     best
