@@ -201,10 +201,7 @@ impl Columns {
         let n = self.dims[0] * self.dims[1];
         self.offsets[n] = self.spans.len() as u32;
         let empty = [f32::INFINITY, f32::NEG_INFINITY];
-        let nth = |line: usize, k: usize| {
-            let (a, b) = (self.offsets[line] as usize, self.offsets[line + 1] as usize);
-            if a + k < b { self.spans[a + k] } else { empty }
-        };
+        let nth = |line: usize, k: usize| self.spans_of(line).get(k).copied().unwrap_or(empty);
         let (mut lo0, mut hi0, mut lo1, mut hi1) = (vec![], vec![], vec![], vec![]);
         for line in 0..n {
             let (first, second) = (nth(line, 0), nth(line, 1));
@@ -219,32 +216,24 @@ impl Columns {
         for v in [&mut hi0, &mut hi1] {
             v.resize(n + LANES, empty[1]);
         }
-        self.more = (0..n)
-            .map(|line| self.offsets[line + 1] - self.offsets[line] > 2)
-            .collect();
+        self.more = (0..n).map(|line| self.spans_of(line).len() > 2).collect();
         (self.lo0, self.hi0, self.lo1, self.hi1) = (lo0, hi0, lo1, hi1);
+    }
+
+    /// The intervals of a line.
+    fn spans_of(&self, line: usize) -> &[[f32; 2]] {
+        &self.spans[self.offsets[line] as usize..self.offsets[line + 1] as usize]
     }
 
     /// Inside length of the line's intervals after its first two, between `lo` and `hi`.
     fn more_inside(&self, line: usize, lo: f32, hi: f32) -> f32 {
-        let (a, b) = (self.offsets[line] as usize, self.offsets[line + 1] as usize);
-        self.spans[a + 2..b]
-            .iter()
-            .map(|s| (s[1].min(hi) - s[0].max(lo)).max(0.0))
-            .sum()
+        clipped_length(&self.spans_of(line)[2..], lo, hi)
     }
 
     /// Inside length of line (i, j) between `lo` and `hi` along the axis.
     fn inside_length(&self, i: i64, j: i64, lo: f32, hi: f32) -> f32 {
-        if i < 0 || j < 0 || i as usize >= self.dims[0] || j as usize >= self.dims[1] {
-            return 0.0;
-        }
-        let line = i as usize * self.dims[1] + j as usize;
-        let (a, b) = (self.offsets[line] as usize, self.offsets[line + 1] as usize);
-        self.spans[a..b]
-            .iter()
-            .map(|s| (s[1].min(hi) - s[0].max(lo)).max(0.0))
-            .sum()
+        self.line(i, j)
+            .map_or(0.0, |line| clipped_length(self.spans_of(line), lo, hi))
     }
 
     /// Volume of each sphere (common `centre`, the given `radii`) outside the solid, written to
@@ -368,11 +357,11 @@ impl Columns {
                 let inside = (load(&self.hi0).min(b) - load(&self.lo0).max(a)).max(f32x8::ZERO)
                     + (load(&self.hi1).min(b) - load(&self.lo1).max(a)).max(f32x8::ZERO);
                 row += (h + h - inside).max(f32x8::ZERO);
-                for k in 0..(left as usize).min(LANES) {
-                    if self.more[line + k] {
-                        let hk = h.to_array()[k];
-                        if hk > 0.0 {
-                            total += -(self.more_inside(line + k, ca - hk, ca + hk) as f64);
+                let lines = line..line + (left as usize).min(LANES);
+                if self.more[lines.clone()].contains(&true) {
+                    for (k, hk) in lines.zip(h.to_array()) {
+                        if self.more[k] && hk > 0.0 {
+                            total -= self.more_inside(k, ca - hk, ca + hk) as f64;
                         }
                     }
                 }
@@ -453,6 +442,14 @@ impl Columns {
         let len: f64 = self.spans.iter().map(|s| (s[1] - s[0]) as f64).sum();
         len * (self.cell as f64).powi(2)
     }
+}
+
+/// Total length of the intervals within [lo, hi].
+fn clipped_length(spans: &[[f32; 2]], lo: f32, hi: f32) -> f32 {
+    spans
+        .iter()
+        .map(|s| (s[1].min(hi) - s[0].max(lo)).max(0.0))
+        .sum()
 }
 
 /// Twice the signed area of the 2D triangle (a, b, c).

@@ -718,8 +718,9 @@ impl Simulation {
 
     /// For a contact already touching at the start: whether the overlap is deeper at the end of
     /// the step than at its start (exact: the meshes overlap at the end more than at the start;
-    /// continuous and spheres: the deepest overlap of leaf spheres grows, or appears). This catches what the contact
-    /// points' velocities miss under rotation: other parts of the surfaces closing in.
+    /// continuous and spheres: the deepest overlap of leaf spheres grows, or appears). This catches
+    /// what the contact points' velocities miss under rotation: other parts of the surfaces closing
+    /// in.
     fn deepens(&self, f: &Found) -> bool {
         let (ta, tb) = (&self.teeth[f.a], &self.teeth[f.b]);
         let (ma, mb) = (&self.motions[f.a], &self.motions[f.b]);
@@ -749,21 +750,27 @@ impl Simulation {
                         })
                         .fold(f32::NEG_INFINITY, f32::max)
                 };
-                // Every overlapping leaf pair at each end of the step (the continuous search
-                // reports only those it needed).
+                // Every overlapping leaf pair at each end of the step. The discrete contact
+                // already lists those at the end; the continuous search reports only those it
+                // needed.
                 let at = |i: usize, pose: Pose| Body {
                     shape: &self.teeth[i].shape,
                     circle: self.teeth[i].circle,
                     motion: Motion::still(pose),
                 };
-                let Some(end) = spheres::query(&at(f.a, ma.end), &at(f.b, mb.end)) else {
-                    return false;
+                let end = if self.method == Method::Spheres {
+                    depth(&f.contact.leaf_pairs, &ma.end, &mb.end)
+                } else {
+                    match spheres::query(&at(f.a, ma.end), &at(f.b, mb.end)) {
+                        Some(c) => depth(&c.leaf_pairs, &ma.end, &mb.end),
+                        None => return false,
+                    }
                 };
                 let start = spheres::query(&at(f.a, ma.start), &at(f.b, mb.start))
                     .map_or(f32::NEG_INFINITY, |c| {
                         depth(&c.leaf_pairs, &ma.start, &mb.start)
                     });
-                depth(&end.leaf_pairs, &ma.end, &mb.end) > start + 1e-6
+                end > start + 1e-6
             }
             Method::Circles => false,
         }

@@ -342,6 +342,7 @@ fn candidates(
     let mut radii = Vec::with_capacity(growth.len());
     let mut costs = vec![0.0f64; growth.len()];
     let mut far = vec![0.0f32; growth.len()];
+    let mut limit2 = vec![0.0f32; growth.len()];
     for &k in seeds {
         let ball = medial_ball(m, pieces.centroid[k], pieces.normal[k], start);
         let r_max = ball.radius + growth[growth.len() - 1] * s;
@@ -350,10 +351,9 @@ fn candidates(
         for b in buckets.iter_mut() {
             b.clear();
         }
-        let limit2: Vec<f32> = growth
-            .iter()
-            .map(|&g| (ball.radius + g * s).powi(2))
-            .collect();
+        for (l, &g) in limit2.iter_mut().zip(growth) {
+            *l = (ball.radius + g * s).powi(2);
+        }
         far.iter_mut().for_each(|f| *f = 0.0);
         grid.within(ball.centre, r_max, |i, r2| {
             // The first step that reaches the piece (counted without branches).
@@ -665,10 +665,9 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
         }
     }
     let (mut points, mut point_owner) = (Vec::new(), Vec::new());
-    let n = POINT_LATTICE;
-    let lattice = Lattice::new(n);
+    let lattice = Lattice::new(POINT_LATTICE);
     for (i, &corners) in pieces.corners.iter().enumerate() {
-        Lattice::points_on(n, corners, &mut points);
+        lattice.points_on(corners, &mut points);
         point_owner.resize(points.len(), owner[i]);
     }
     shrink(
@@ -928,26 +927,29 @@ fn shrink(
     }
 }
 
-/// The lattice of points on each piece: how many, and which are the corners.
+/// The lattice of points on each piece: n + 1 points per edge, how many in all, and which are
+/// the corners.
 #[derive(Clone, Copy)]
 struct Lattice {
+    n: u32,
     len: usize,
     corners: [usize; 3],
 }
 
 impl Lattice {
-    /// n + 1 points per edge, in the order `points_on` writes them.
     fn new(n: u32) -> Self {
-        let n = n.max(1) as usize;
+        let n = n.max(1);
+        let len = (n as usize + 1) * (n as usize + 2) / 2;
         Self {
-            len: (n + 1) * (n + 2) / 2,
-            corners: [0, (n + 1) * (n + 2) / 2 - 1, n],
+            n,
+            len,
+            corners: [0, len - 1, n as usize],
         }
     }
 
     /// The lattice points of a piece: a + (b − a)·u/n + (c − a)·v/n for u + v ≤ n, u major.
-    fn points_on(n: u32, [a, b, c]: [Vec3; 3], out: &mut Vec<Vec3>) {
-        let n = n.max(1);
+    fn points_on(&self, [a, b, c]: [Vec3; 3], out: &mut Vec<Vec3>) {
+        let n = self.n;
         for u in 0..=n {
             for v in 0..=n - u {
                 let (fu, fv) = (u as f32 / n as f32, v as f32 / n as f32);
