@@ -12,6 +12,14 @@
 //! a relative 10⁻⁶. Hence a lane is rejected only when the exact spheres are provably apart: the
 //! tests are conservative, never exact, and a little generous (about 10⁻⁴ mm at 10⁴ mm from the
 //! origin, 10⁻⁶ mm near it).
+//!
+//! **Instruction sets.** The build targets every x86-64 (SSE2), where an eight-lane vector is two
+//! four-lane halves. On a processor with AVX2 and FMA (checked once at run time), [`run`] compiles
+//! a descent for those instructions and hands it [`Avx2`] lanes, whose tests are single 256-bit
+//! operations; elsewhere it hands it [`Portable`] lanes. Both evaluate the same f32 expressions in
+//! the same order, without fused multiply-adds, so their masks are bit-identical (tested): the
+//! rounding argument above holds for either. This module holds orthosim's only `unsafe` code: the
+//! calls into functions compiled for AVX2, made only after the processor was found to have it.
 
 use glam::{DMat3, DQuat, DVec3, Mat3, Vec3};
 use wide::f32x8;
@@ -89,6 +97,240 @@ pub fn overlap_mask(
     let dz = f32x8::from(*z) - f32x8::splat(p.z);
     let rr = (f32x8::from(*r) + f32x8::splat(rp) + f32x8::splat(slack)) * f32x8::splat(GROW);
     (dx * dx + dy * dy + dz * dz).simd_le(rr * rr).to_bitmask() & used
+}
+
+/// Every pair of lanes of two chunks at once: bit l of `rows[k]` is set when lane k of `a` (centre
+/// (a.x[k], a.y[k], a.z[k]), radius a.r[k]) and lane l of `b` are within `slack` of touching, for l
+/// in `used_b` (k over all [`LANES`]; unused lanes of `a` give rows to be masked by the caller).
+/// Bit k of `any` is set when `rows[k]` is not empty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Block {
+    /// Per lane of `a`, the lanes of `b` it meets.
+    pub rows: [u32; LANES],
+    /// Lanes of `a` that meet some lane of `b`.
+    pub any: u32,
+}
+
+/// The lane tests, for one instruction set. [`Portable`] and [`Avx2`] give identical results.
+pub trait Lanes: Copy {
+    /// [`overlap_mask`].
+    fn overlap_mask(
+        self,
+        xyz: [&[f32; LANES]; 3],
+        r: &[f32; LANES],
+        p: Vec3,
+        rp: f32,
+        slack: f32,
+        used: u32,
+    ) -> u32;
+
+    /// The [`Block`] of chunk `a` (local coordinates) against lanes (`b`, `rb`).
+    fn block(
+        self,
+        a: &Chunk,
+        b: [&[f32; LANES]; 3],
+        rb: &[f32; LANES],
+        slack: f32,
+        used_b: u32,
+    ) -> Block;
+}
+
+/// Lane tests in [`wide`] vectors: SSE2 on x86-64, whatever the target offers elsewhere.
+#[derive(Clone, Copy, Debug)]
+pub struct Portable;
+
+impl Lanes for Portable {
+    #[inline(always)]
+    fn overlap_mask(
+        self,
+        xyz: [&[f32; LANES]; 3],
+        r: &[f32; LANES],
+        p: Vec3,
+        rp: f32,
+        slack: f32,
+        used: u32,
+    ) -> u32 {
+        overlap_mask(xyz, r, p, rp, slack, used)
+    }
+
+    #[inline(always)]
+    fn block(
+        self,
+        a: &Chunk,
+        b: [&[f32; LANES]; 3],
+        rb: &[f32; LANES],
+        slack: f32,
+        used_b: u32,
+    ) -> Block {
+        let mut out = Block {
+            rows: [0; LANES],
+            any: 0,
+        };
+        for k in 0..LANES {
+            let p = Vec3::new(a.x[k], a.y[k], a.z[k]);
+            out.rows[k] = overlap_mask(b, rb, p, a.r[k], slack, used_b);
+            out.any |= ((out.rows[k] != 0) as u32) << k;
+        }
+        out
+    }
+}
+
+/// A computation over lanes, run by [`run`] with the best [`Lanes`] this processor has.
+pub trait LaneTask {
+    /// What it returns.
+    type Output;
+    /// Runs with `lanes`.
+    fn run<L: Lanes>(self, lanes: L) -> Self::Output;
+}
+
+/// Runs `task` with [`Avx2`] lanes, compiled for AVX2 and FMA, when the processor has them, and
+/// with [`Portable`] lanes otherwise.
+#[inline]
+pub fn run<T: LaneTask>(task: T) -> T::Output {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(avx2) = Avx2::detect() {
+        return avx2::run(avx2, task);
+    }
+    task.run(Portable)
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use avx2::Avx2;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    #![allow(
+        unsafe_code,
+        reason = "calls into code compiled for AVX2, after detecting it"
+    )]
+
+    use std::arch::x86_64::{
+        __m256, _CMP_LE_OQ, _mm256_add_ps, _mm256_cmp_ps, _mm256_movemask_ps, _mm256_mul_ps,
+        _mm256_set1_ps, _mm256_sub_ps,
+    };
+
+    use glam::Vec3;
+
+    use super::{Block, Chunk, GROW, LANES, LaneTask, Lanes};
+
+    /// Lane tests in 256-bit AVX instructions. Only [`Avx2::detect`] makes one, on a processor with
+    /// AVX2 and FMA: holding one is the proof that calling code compiled for them is sound.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx2(());
+
+    impl Avx2 {
+        /// `Some` when this processor has AVX2 and FMA (the check is cached by the standard
+        /// library).
+        #[inline]
+        pub fn detect() -> Option<Self> {
+            (std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma"))
+                .then_some(Self(()))
+        }
+    }
+
+    pub(super) fn run<T: LaneTask>(lanes: Avx2, task: T) -> T::Output {
+        // SAFETY: `lanes` exists, so the processor has AVX2 and FMA (see `Avx2::detect`).
+        unsafe { run_avx2(lanes, task) }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn run_avx2<T: LaneTask>(lanes: Avx2, task: T) -> T::Output {
+        task.run(lanes)
+    }
+
+    #[inline(always)]
+    fn load(v: &[f32; LANES]) -> __m256 {
+        bytemuck::cast(*v)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn mask(dx: __m256, dy: __m256, dz: __m256, reach: __m256, used: u32) -> u32 {
+        // The same expression, in the same order, as `super::overlap_mask`.
+        let d2 = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+            _mm256_mul_ps(dz, dz),
+        );
+        let rr = _mm256_mul_ps(reach, _mm256_set1_ps(GROW));
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(d2, _mm256_mul_ps(rr, rr))) as u32 & used
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn overlap_mask(
+        [x, y, z]: [&[f32; LANES]; 3],
+        r: &[f32; LANES],
+        p: Vec3,
+        rp: f32,
+        slack: f32,
+        used: u32,
+    ) -> u32 {
+        mask(
+            _mm256_sub_ps(load(x), _mm256_set1_ps(p.x)),
+            _mm256_sub_ps(load(y), _mm256_set1_ps(p.y)),
+            _mm256_sub_ps(load(z), _mm256_set1_ps(p.z)),
+            _mm256_add_ps(
+                _mm256_add_ps(load(r), _mm256_set1_ps(rp)),
+                _mm256_set1_ps(slack),
+            ),
+            used,
+        )
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn block(
+        a: &Chunk,
+        [x, y, z]: [&[f32; LANES]; 3],
+        rb: &[f32; LANES],
+        slack: f32,
+        used_b: u32,
+    ) -> Block {
+        let (x, y, z, r) = (load(x), load(y), load(z), load(rb));
+        let slack = _mm256_set1_ps(slack);
+        let mut out = Block {
+            rows: [0; LANES],
+            any: 0,
+        };
+        for k in 0..LANES {
+            let m = mask(
+                _mm256_sub_ps(x, _mm256_set1_ps(a.x[k])),
+                _mm256_sub_ps(y, _mm256_set1_ps(a.y[k])),
+                _mm256_sub_ps(z, _mm256_set1_ps(a.z[k])),
+                _mm256_add_ps(_mm256_add_ps(r, _mm256_set1_ps(a.r[k])), slack),
+                used_b,
+            );
+            out.rows[k] = m;
+            out.any |= ((m != 0) as u32) << k;
+        }
+        out
+    }
+
+    impl Lanes for Avx2 {
+        #[inline(always)]
+        fn overlap_mask(
+            self,
+            xyz: [&[f32; LANES]; 3],
+            r: &[f32; LANES],
+            p: Vec3,
+            rp: f32,
+            slack: f32,
+            used: u32,
+        ) -> u32 {
+            // SAFETY: `self` exists, so the processor has AVX2 and FMA.
+            unsafe { overlap_mask(xyz, r, p, rp, slack, used) }
+        }
+
+        #[inline(always)]
+        fn block(
+            self,
+            a: &Chunk,
+            b: [&[f32; LANES]; 3],
+            rb: &[f32; LANES],
+            slack: f32,
+            used_b: u32,
+        ) -> Block {
+            // SAFETY: as above.
+            unsafe { block(a, b, rb, slack, used_b) }
+        }
+    }
 }
 
 /// Start and end centres and inflated radii of a chunk's lanes over a step.
@@ -202,6 +444,91 @@ mod tests {
             }
         }
         assert!(worst > 0.0);
+    }
+
+    /// A chunk `a`, lanes `b` (x, y, z, r) with the used mask, a probe sphere and a slack.
+    type Case = (Chunk, [[f32; LANES]; 4], u32, Vec3, f32, f32);
+
+    /// Random chunks and probes around near-touching distances, some lanes unused.
+    fn random_cases(seed: u64, n: usize) -> Vec<Case> {
+        let mut s = seed;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n)
+            .map(|_| {
+                let mut a = Chunk {
+                    len: 1 + (rnd() * 8.0) as u32 % 8,
+                    ..Default::default()
+                };
+                let mut b = [[0.0; LANES]; 4];
+                for k in 0..LANES {
+                    (a.x[k], a.y[k], a.z[k]) = (rnd() * 6.0, rnd() * 6.0, rnd() * 6.0);
+                    a.r[k] = 0.2 + rnd() * 2.0;
+                    for c in 0..3 {
+                        b[c][k] = rnd() * 6.0;
+                    }
+                    b[3][k] = 0.2 + rnd() * 2.0;
+                }
+                let used_b = (rnd() * 256.0) as u32 & 0xff;
+                let p = Vec3::new(rnd() * 6.0, rnd() * 6.0, rnd() * 6.0);
+                (a, b, used_b, p, 0.2 + rnd() * 2.0, rnd() * 1e-3)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_block_is_eight_lane_tests() {
+        let (mut pairs, mut empty_rows) = (0, 0);
+        for (a, b, used_b, _, _, slack) in random_cases(7, 2000) {
+            let xyz = [&b[0], &b[1], &b[2]];
+            let block = Portable.block(&a, xyz, &b[3], slack, used_b);
+            for k in 0..LANES {
+                let p = Vec3::new(a.x[k], a.y[k], a.z[k]);
+                let row = overlap_mask(xyz, &b[3], p, a.r[k], slack, used_b);
+                assert_eq!(block.rows[k], row);
+                assert_eq!(block.any >> k & 1 != 0, row != 0);
+                pairs += row.count_ones();
+                empty_rows += (row == 0) as u32;
+            }
+        }
+        // The cases mix touching and apart lanes.
+        assert!(pairs > 10_000 && empty_rows > 1000, "{pairs} {empty_rows}");
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_lanes_give_the_portable_masks() {
+        let Some(avx2) = Avx2::detect() else {
+            eprintln!("no AVX2 on this processor: only the portable lanes are used");
+            return;
+        };
+        for (a, b, used_b, p, rp, slack) in random_cases(11, 5000) {
+            let xyz = [&b[0], &b[1], &b[2]];
+            assert_eq!(
+                avx2.block(&a, xyz, &b[3], slack, used_b),
+                Portable.block(&a, xyz, &b[3], slack, used_b)
+            );
+            let used = a.used();
+            assert_eq!(
+                avx2.overlap_mask([&a.x, &a.y, &a.z], &a.r, p, rp, slack, used),
+                Portable.overlap_mask([&a.x, &a.y, &a.z], &a.r, p, rp, slack, used)
+            );
+        }
+        // On the boundary (d² equal to the grown contact distance squared) both pass the lane.
+        let mut c = Chunk::default();
+        c.x[0] = (0.5f32 + 1.0 + 0.0) * GROW;
+        c.r[0] = 0.5;
+        c.len = 1;
+        for touching in [
+            avx2.overlap_mask([&c.x, &c.y, &c.z], &c.r, Vec3::ZERO, 1.0, 0.0, 1),
+            Portable.overlap_mask([&c.x, &c.y, &c.z], &c.r, Vec3::ZERO, 1.0, 0.0, 1),
+        ] {
+            assert_eq!(touching, 1);
+        }
     }
 
     #[test]
