@@ -19,6 +19,14 @@
 //!    [`first_contact`]); R carries the f32 slack of the mapped centres, so the same holds for the
 //!    real motion.
 //!
+//! 3. **Descent.** A pair of inner nodes with up to eight children each is split on both sides at
+//!    once: the children of each side whose swept spheres meet the other node, then all pairs of
+//!    those (an 8 × 8 block of interval tests, [`Lanes::swept_block`]), and Eq. 2 for the pairs
+//!    that pass. Dropping children that miss the other node is safe: where the surfaces touch at
+//!    time t, the contact point lies in a leaf of each tree and, by the coverage invariant, in
+//!    every ancestor of either at time t, so all those ancestors' swept spheres meet. Other pairs
+//!    (a leaf against an inner node, wider branching) split the larger sphere.
+//!
 //! A node pair's time bounds its descendants' from below, so the search visits pairs earliest first
 //! and, for the continuous method, skips pairs that cannot beat the earliest leaf time found. The
 //! pair's time of contact is the least leaf time in [0, 1). ([`may_meet`], the interval test plus
@@ -31,7 +39,7 @@ use glam::{DVec3, Vec3};
 
 use super::{
     Body, PairContact,
-    lanes::{Affine32, SweptChunk, bits, f32_slack, swept_mask},
+    lanes::{self, Affine32, LaneTask, Lanes, SweptChunk, bits, f32_slack},
 };
 use crate::{
     collision::{
@@ -163,20 +171,18 @@ pub fn swept_leaves(
         cache_a.begin(ta.chunks.len());
         cache_b.begin(tb.chunks.len());
         stack.clear();
-        descend(
-            Descent {
-                ta,
-                tb,
-                maps,
-                k,
-                slack,
-                earliest_only,
-            },
+        lanes::run(Descent {
+            ta,
+            tb,
+            maps,
+            k,
+            slack,
+            earliest_only,
             cache_a,
             cache_b,
             stack,
-            &mut leaf,
-        );
+            leaf: &mut leaf,
+        });
     });
 }
 
@@ -198,13 +204,20 @@ thread_local! {
         const { std::cell::RefCell::new((NodeCache::new(), NodeCache::new(), Vec::new())) };
 }
 
-struct Descent<'q> {
+/// One query's descent.
+struct Descent<'q, F> {
     ta: &'q CompactTree,
     tb: &'q CompactTree,
+    /// Start and end maps of a, then of b.
     maps: [Affine32; 4],
+    /// Arc–chord factors of a and b.
     k: [f32; 2],
     slack: f32,
     earliest_only: bool,
+    cache_a: &'q mut NodeCache<SweptChunk>,
+    cache_b: &'q mut NodeCache<SweptChunk>,
+    stack: &'q mut Vec<Item>,
+    leaf: &'q mut F,
 }
 
 /// The first time (Eq. 2) of a node pair that passed the interval test, from f32 centres: the
@@ -220,15 +233,16 @@ fn pair_time(a: (Vec3, Vec3, f32), b: (Vec3, Vec3, f32), slack: f32) -> Option<f
 
 /// Calls `push(node, lane, time)` for each lane of a chunk whose swept sphere meets `other`'s
 /// during the step, with the pair's first time. (The time is symmetric in the two spheres.)
-#[inline]
+#[inline(always)]
 fn meeting_lanes(
+    lanes: impl Lanes,
     ch: &Chunk,
     sw: &SweptChunk,
     other: (Vec3, Vec3, f32),
     slack: f32,
     mut push: impl FnMut(u32, (Vec3, Vec3, f32), f64),
 ) {
-    for l in bits(swept_mask(sw, other.0, other.1, other.2, slack, ch.used())) {
+    for l in bits(lanes.swept_mask(sw, other.0, other.1, other.2, slack, ch.used())) {
         let lane = sw.lane(l);
         if let Some(t) = pair_time(lane, other, slack) {
             push(ch.node[l], lane, t);
@@ -236,69 +250,100 @@ fn meeting_lanes(
     }
 }
 
-fn descend(
-    q: Descent,
-    cache_a: &mut NodeCache<SweptChunk>,
-    cache_b: &mut NodeCache<SweptChunk>,
-    stack: &mut Vec<Item>,
-    leaf: &mut impl FnMut(usize, usize, f64),
-) {
-    let Descent {
-        ta,
-        tb,
-        maps: [a0, a1, b0, b1],
-        k: [ka, kb],
-        slack,
-        earliest_only,
-    } = q;
-    let mut best = f64::INFINITY;
-    let root_a = cache_a.get(0, || SweptChunk::new(&ta.chunks[0], &a0, &a1, ka));
-    let root_b = cache_b.get(0, || SweptChunk::new(&tb.chunks[0], &b0, &b1, kb));
-    let (ra, rb) = (root_a.lane(0), root_b.lane(0));
-    if swept_mask(&root_a, rb.0, rb.1, rb.2, slack, 1) != 0
-        && let Some(t) = pair_time(ra, rb, slack)
-    {
-        stack.push(Item {
-            i: 0,
-            j: 0,
-            t,
-            a: ra,
-            b: rb,
-        });
-    }
-    // Depth first, the children of a pair visited earliest first, so that with `earliest_only`
-    // a good bound is found early and later subtrees are cut.
-    while let Some(it) = stack.pop() {
-        if earliest_only && it.t >= best {
-            continue;
+impl<F: FnMut(usize, usize, f64)> LaneTask for Descent<'_, F> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lanes>(self, lanes: L) {
+        let Descent {
+            ta,
+            tb,
+            maps: [a0, a1, b0, b1],
+            k: [ka, kb],
+            slack,
+            earliest_only,
+            cache_a,
+            cache_b,
+            stack,
+            leaf,
+        } = self;
+        let mut best = f64::INFINITY;
+        let root_a = cache_a.get(0, || SweptChunk::new(&ta.chunks[0], &a0, &a1, ka));
+        let root_b = cache_b.get(0, || SweptChunk::new(&tb.chunks[0], &b0, &b1, kb));
+        let (ra, rb) = (root_a.lane(0), root_b.lane(0));
+        if lanes.swept_mask(&root_a, rb.0, rb.1, rb.2, slack, 1) != 0
+            && let Some(t) = pair_time(ra, rb, slack)
+        {
+            stack.push(Item {
+                i: 0,
+                j: 0,
+                t,
+                a: ra,
+                b: rb,
+            });
         }
-        let (i, j) = (it.i as usize, it.j as usize);
-        let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
-        if la && lb {
-            best = best.min(it.t);
-            leaf(i, j, it.t);
-            continue;
-        }
-        let first = stack.len();
-        if !la && (lb || ta.spheres[i].radius >= tb.spheres[j].radius) {
-            for c in ta.child_chunks[i].clone() {
-                let ch = &ta.chunks[c as usize];
-                let sw = cache_a.get_ref(c as usize, || SweptChunk::new(ch, &a0, &a1, ka));
-                meeting_lanes(ch, sw, it.b, slack, |i, a, t| {
-                    stack.push(Item { i, t, a, ..it })
-                });
+        // Depth first, the children of a pair visited earliest first, so that with
+        // `earliest_only` a good bound is found early and later subtrees are cut.
+        while let Some(it) = stack.pop() {
+            if earliest_only && it.t >= best {
+                continue;
             }
-        } else {
-            for c in tb.child_chunks[j].clone() {
-                let ch = &tb.chunks[c as usize];
-                let sw = cache_b.get_ref(c as usize, || SweptChunk::new(ch, &b0, &b1, kb));
-                meeting_lanes(ch, sw, it.a, slack, |j, b, t| {
-                    stack.push(Item { j, t, b, ..it })
-                });
+            let (i, j) = (it.i as usize, it.j as usize);
+            let (la, lb) = (ta.is_leaf(i), tb.is_leaf(j));
+            if la && lb {
+                best = best.min(it.t);
+                leaf(i, j, it.t);
+                continue;
             }
-        }
-        if earliest_only {
-            stack[first..].sort_unstable_by(|x, y| y.t.total_cmp(&x.t));
+            let first = stack.len();
+            let (rca, rcb) = (ta.child_chunks[i].clone(), tb.child_chunks[j].clone());
+            if !la && !lb && rca.len() == 1 && rcb.len() == 1 {
+                // Both inner with up to eight children each: all pairs of children at once,
+                // keeping children of each side that meet the other node (see the module doc).
+                let (ca, cb) = (
+                    &ta.chunks[rca.start as usize],
+                    &tb.chunks[rcb.start as usize],
+                );
+                let sa = *cache_a.get_ref(rca.start as usize, || SweptChunk::new(ca, &a0, &a1, ka));
+                let sb = cache_b.get_ref(rcb.start as usize, || SweptChunk::new(cb, &b0, &b1, kb));
+                let ma = lanes.swept_mask(&sa, it.b.0, it.b.1, it.b.2, slack, ca.used());
+                let mb = lanes.swept_mask(sb, it.a.0, it.a.1, it.a.2, slack, cb.used());
+                let block = lanes.swept_block(&sa, sb, slack, mb);
+                for x in bits(block.any & ma) {
+                    let a = sa.lane(x);
+                    for y in bits(block.rows[x]) {
+                        let b = sb.lane(y);
+                        if let Some(t) = pair_time(a, b, slack) {
+                            stack.push(Item {
+                                i: ca.node[x],
+                                j: cb.node[y],
+                                t,
+                                a,
+                                b,
+                            });
+                        }
+                    }
+                }
+            } else if !la && (lb || ta.spheres[i].radius >= tb.spheres[j].radius) {
+                for c in rca {
+                    let ch = &ta.chunks[c as usize];
+                    let sw = cache_a.get_ref(c as usize, || SweptChunk::new(ch, &a0, &a1, ka));
+                    meeting_lanes(lanes, ch, sw, it.b, slack, |i, a, t| {
+                        stack.push(Item { i, t, a, ..it })
+                    });
+                }
+            } else {
+                for c in rcb {
+                    let ch = &tb.chunks[c as usize];
+                    let sw = cache_b.get_ref(c as usize, || SweptChunk::new(ch, &b0, &b1, kb));
+                    meeting_lanes(lanes, ch, sw, it.a, slack, |j, b, t| {
+                        stack.push(Item { j, t, b, ..it })
+                    });
+                }
+            }
+            if earliest_only {
+                stack[first..].sort_unstable_by(|x, y| y.t.total_cmp(&x.t));
+            }
         }
     }
 }

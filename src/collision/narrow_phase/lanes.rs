@@ -133,6 +133,13 @@ pub trait Lanes: Copy {
         slack: f32,
         used_b: u32,
     ) -> Block;
+
+    /// [`swept_mask`].
+    fn swept_mask(self, s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32;
+
+    /// The [`Block`] of swept lanes: bit l of `rows[k]` set when [`swept_mask`] passes lane l of
+    /// `b` against lane k of `a`.
+    fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block;
 }
 
 /// Lane tests in [`wide`] vectors: SSE2 on x86-64, whatever the target offers elsewhere.
@@ -173,6 +180,25 @@ impl Lanes for Portable {
         }
         out
     }
+
+    #[inline(always)]
+    fn swept_mask(self, s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
+        swept_mask(s, p0, p1, rp, slack, used)
+    }
+
+    #[inline(always)]
+    fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
+        let mut out = Block {
+            rows: [0; LANES],
+            any: 0,
+        };
+        for k in 0..LANES {
+            let (p0, p1, r) = a.lane(k);
+            out.rows[k] = swept_mask(b, p0, p1, r, slack, used_b);
+            out.any |= ((out.rows[k] != 0) as u32) << k;
+        }
+        out
+    }
 }
 
 /// A computation over lanes, run by [`run`] with the best [`Lanes`] this processor has.
@@ -205,13 +231,14 @@ mod avx2 {
     )]
 
     use std::arch::x86_64::{
-        __m256, _CMP_LE_OQ, _mm256_add_ps, _mm256_cmp_ps, _mm256_movemask_ps, _mm256_mul_ps,
-        _mm256_set1_ps, _mm256_sub_ps,
+        __m256, _CMP_GT_OQ, _CMP_LE_OQ, _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps,
+        _mm256_cmp_ps, _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps,
+        _mm256_setzero_ps, _mm256_sub_ps,
     };
 
     use glam::Vec3;
 
-    use super::{Block, Chunk, GROW, LANES, LaneTask, Lanes};
+    use super::{Block, Chunk, GROW, LANES, LaneTask, Lanes, SweptChunk};
 
     /// Lane tests in 256-bit AVX instructions. Only [`Avx2::detect`] makes one, on a processor with
     /// AVX2 and FMA: holding one is the proof that calling code compiled for them is sound.
@@ -303,6 +330,51 @@ mod avx2 {
         out
     }
 
+    /// The lower bound of |A + (E − A)·t|² over the step, as `super::swept_mask` computes it.
+    #[target_feature(enable = "avx2,fma")]
+    fn swept_lo(s: &SweptChunk, p0: Vec3, p1: Vec3) -> __m256 {
+        let sign = _mm256_set1_ps(-0.0);
+        let mut lo = _mm256_setzero_ps();
+        for (axis, (q0, q1)) in [(p0.x, p1.x), (p0.y, p1.y), (p0.z, p1.z)]
+            .into_iter()
+            .enumerate()
+        {
+            let a = _mm256_sub_ps(load(&s.start[axis]), _mm256_set1_ps(q0));
+            let e = _mm256_sub_ps(load(&s.end[axis]), _mm256_set1_ps(q1));
+            let near = _mm256_min_ps(_mm256_andnot_ps(sign, a), _mm256_andnot_ps(sign, e));
+            let same = _mm256_cmp_ps::<_CMP_GT_OQ>(_mm256_mul_ps(a, e), _mm256_setzero_ps());
+            let m = _mm256_and_ps(near, same);
+            lo = _mm256_add_ps(lo, _mm256_mul_ps(m, m));
+        }
+        lo
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn swept_mask(s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
+        let lo = swept_lo(s, p0, p1);
+        let reach = _mm256_add_ps(
+            _mm256_add_ps(load(&s.r), _mm256_set1_ps(rp)),
+            _mm256_set1_ps(slack),
+        );
+        let rr = _mm256_mul_ps(reach, _mm256_set1_ps(GROW));
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(lo, _mm256_mul_ps(rr, rr))) as u32 & used
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    fn swept_block(a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
+        let mut out = Block {
+            rows: [0; LANES],
+            any: 0,
+        };
+        for k in 0..LANES {
+            let (p0, p1, r) = a.lane(k);
+            let m = swept_mask(b, p0, p1, r, slack, used_b);
+            out.rows[k] = m;
+            out.any |= ((m != 0) as u32) << k;
+        }
+        out
+    }
+
     impl Lanes for Avx2 {
         #[inline(always)]
         fn overlap_mask(
@@ -329,6 +401,26 @@ mod avx2 {
         ) -> Block {
             // SAFETY: as above.
             unsafe { block(a, b, rb, slack, used_b) }
+        }
+
+        #[inline(always)]
+        fn swept_mask(
+            self,
+            s: &SweptChunk,
+            p0: Vec3,
+            p1: Vec3,
+            rp: f32,
+            slack: f32,
+            used: u32,
+        ) -> u32 {
+            // SAFETY: as above.
+            unsafe { swept_mask(s, p0, p1, rp, slack, used) }
+        }
+
+        #[inline(always)]
+        fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
+            // SAFETY: as above.
+            unsafe { swept_block(a, b, slack, used_b) }
         }
     }
 }
@@ -517,15 +609,40 @@ mod tests {
                 avx2.overlap_mask([&a.x, &a.y, &a.z], &a.r, p, rp, slack, used),
                 Portable.overlap_mask([&a.x, &a.y, &a.z], &a.r, p, rp, slack, used)
             );
+            // Swept: a's lanes moving by a random step, b's lanes moving another way.
+            let mut lanes_b = Chunk {
+                len: LANES as u32,
+                ..Default::default()
+            };
+            (lanes_b.x, lanes_b.y, lanes_b.z, lanes_b.r) = (b[0], b[1], b[2], b[3]);
+            let shift = |d: Vec3| Affine32::new(DQuat::IDENTITY, d.as_dvec3());
+            let (sa, sb) = (
+                SweptChunk::new(&a, &shift(Vec3::ZERO), &shift(p - Vec3::splat(3.0)), 0.0),
+                SweptChunk::new(&lanes_b, &shift(Vec3::ZERO), &shift(Vec3::ZERO), 0.01),
+            );
+            assert_eq!(
+                avx2.swept_block(&sa, &sb, slack, used_b),
+                Portable.swept_block(&sa, &sb, slack, used_b)
+            );
+            let (p0, p1) = (p, Vec3::new(p.y, p.z, p.x));
+            assert_eq!(
+                avx2.swept_mask(&sa, p0, p1, rp, slack, used),
+                Portable.swept_mask(&sa, p0, p1, rp, slack, used)
+            );
         }
         // On the boundary (d² equal to the grown contact distance squared) both pass the lane.
         let mut c = Chunk::default();
         c.x[0] = (0.5f32 + 1.0 + 0.0) * GROW;
         c.r[0] = 0.5;
         c.len = 1;
+        let id = Affine32::new(DQuat::IDENTITY, DVec3::ZERO);
+        let s = SweptChunk::new(&c, &id, &id, 0.0);
+        let (p0, p1) = (Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0));
         for touching in [
             avx2.overlap_mask([&c.x, &c.y, &c.z], &c.r, Vec3::ZERO, 1.0, 0.0, 1),
             Portable.overlap_mask([&c.x, &c.y, &c.z], &c.r, Vec3::ZERO, 1.0, 0.0, 1),
+            avx2.swept_mask(&s, p0, p1, 1.0, 0.0, 1),
+            Portable.swept_mask(&s, p0, p1, 1.0, 0.0, 1),
         ] {
             assert_eq!(touching, 1);
         }

@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | [`circles`] | end pose | the paper's Eq. 1 on bounding circles in the x–z plane; coarse, no guarantee (ignores height, so upper and lower teeth always "collide") |
 //! | [`spheres`] | end pose | conservative: if the meshes overlap or touch at the end pose, some pair of leaves overlaps (coverage invariant), so no false negatives at that pose |
-//! | [`continuous`] | whole step | conservative: no false negatives for any contact during the step, and the reported time is never later than the true first contact of the swept leaf spheres (hence of the meshes) |
+//! | [`continuous`] | whole step | conservative: no false negatives for any contact during the step, and the reported time is never later than the first contact of the swept leaf spheres that hold the meshes' first contact point (hence of the meshes) |
 //! | [`exact`] | whole step | the continuous stage, then conservative advancement on the candidate triangles: the time is never after the meshes' first contact and the gap left there is at most [`exact::GAP_TOLERANCE_MM`] |
 //!
 //! Results are [`PairContact`]s in world coordinates; `depth_mm` is a penetration depth when
