@@ -304,11 +304,11 @@ impl<F: FnMut(usize, usize, f64)> LaneTask for Descent<'_, F> {
                     &ta.chunks[rca.start as usize],
                     &tb.chunks[rcb.start as usize],
                 );
-                let sa = *cache_a.get_ref(rca.start as usize, || SweptChunk::new(ca, &a0, &a1, ka));
+                let sa = cache_a.get_ref(rca.start as usize, || SweptChunk::new(ca, &a0, &a1, ka));
                 let sb = cache_b.get_ref(rcb.start as usize, || SweptChunk::new(cb, &b0, &b1, kb));
-                let ma = lanes.swept_mask(&sa, it.b.0, it.b.1, it.b.2, slack, ca.used());
+                let ma = lanes.swept_mask(sa, it.b.0, it.b.1, it.b.2, slack, ca.used());
                 let mb = lanes.swept_mask(sb, it.a.0, it.a.1, it.a.2, slack, cb.used());
-                let block = lanes.swept_block(&sa, sb, slack, mb);
+                let block = lanes.swept_block(sa, sb, slack, mb);
                 for x in bits(block.any & ma) {
                     let a = sa.lane(x);
                     for y in bits(block.rows[x]) {

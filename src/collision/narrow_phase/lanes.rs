@@ -124,7 +124,12 @@ pub trait Lanes: Copy {
         used: u32,
     ) -> u32;
 
-    /// The [`Block`] of chunk `a` (local coordinates) against lanes (`b`, `rb`).
+    /// [`swept_mask`].
+    fn swept_mask(self, s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32;
+
+    /// The [`Block`] of chunk `a` (local coordinates) against lanes (`b`, `rb`): eight
+    /// [`Self::overlap_mask`] tests, one per lane of `a`, without branches.
+    #[inline(always)]
     fn block(
         self,
         a: &Chunk,
@@ -132,14 +137,38 @@ pub trait Lanes: Copy {
         rb: &[f32; LANES],
         slack: f32,
         used_b: u32,
-    ) -> Block;
+    ) -> Block {
+        Block::of(|k| {
+            let p = Vec3::new(a.x[k], a.y[k], a.z[k]);
+            self.overlap_mask(b, rb, p, a.r[k], slack, used_b)
+        })
+    }
 
-    /// [`swept_mask`].
-    fn swept_mask(self, s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32;
+    /// The [`Block`] of swept lanes: bit l of `rows[k]` set when [`Self::swept_mask`] passes lane
+    /// l of `b` against lane k of `a`.
+    #[inline(always)]
+    fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
+        Block::of(|k| {
+            let (p0, p1, r) = a.lane(k);
+            self.swept_mask(b, p0, p1, r, slack, used_b)
+        })
+    }
+}
 
-    /// The [`Block`] of swept lanes: bit l of `rows[k]` set when [`swept_mask`] passes lane l of
-    /// `b` against lane k of `a`.
-    fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block;
+impl Block {
+    /// The block whose row k is `row(k)`.
+    #[inline(always)]
+    fn of(mut row: impl FnMut(usize) -> u32) -> Self {
+        let mut out = Self {
+            rows: [0; LANES],
+            any: 0,
+        };
+        for k in 0..LANES {
+            out.rows[k] = row(k);
+            out.any |= ((out.rows[k] != 0) as u32) << k;
+        }
+        out
+    }
 }
 
 /// Lane tests in [`wide`] vectors: SSE2 on x86-64, whatever the target offers elsewhere.
@@ -161,43 +190,8 @@ impl Lanes for Portable {
     }
 
     #[inline(always)]
-    fn block(
-        self,
-        a: &Chunk,
-        b: [&[f32; LANES]; 3],
-        rb: &[f32; LANES],
-        slack: f32,
-        used_b: u32,
-    ) -> Block {
-        let mut out = Block {
-            rows: [0; LANES],
-            any: 0,
-        };
-        for k in 0..LANES {
-            let p = Vec3::new(a.x[k], a.y[k], a.z[k]);
-            out.rows[k] = overlap_mask(b, rb, p, a.r[k], slack, used_b);
-            out.any |= ((out.rows[k] != 0) as u32) << k;
-        }
-        out
-    }
-
-    #[inline(always)]
     fn swept_mask(self, s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
         swept_mask(s, p0, p1, rp, slack, used)
-    }
-
-    #[inline(always)]
-    fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
-        let mut out = Block {
-            rows: [0; LANES],
-            any: 0,
-        };
-        for k in 0..LANES {
-            let (p0, p1, r) = a.lane(k);
-            out.rows[k] = swept_mask(b, p0, p1, r, slack, used_b);
-            out.any |= ((out.rows[k] != 0) as u32) << k;
-        }
-        out
     }
 }
 
@@ -238,7 +232,7 @@ mod avx2 {
 
     use glam::Vec3;
 
-    use super::{Block, Chunk, GROW, LANES, LaneTask, Lanes, SweptChunk};
+    use super::{GROW, LANES, LaneTask, Lanes, SweptChunk};
 
     /// Lane tests in 256-bit AVX instructions. Only [`Avx2::detect`] makes one, on a processor with
     /// AVX2 and FMA: holding one is the proof that calling code compiled for them is sound.
@@ -270,15 +264,17 @@ mod avx2 {
         bytemuck::cast(*v)
     }
 
+    /// Bit k set when `sq[k]` is within the grown contact distance of lane k (radius `r[k]`) and
+    /// a sphere of radius `rp`, for the lanes in `used`: the comparison of `super::overlap_mask`
+    /// and `super::swept_mask`, in the same order.
     #[target_feature(enable = "avx2,fma")]
-    fn mask(dx: __m256, dy: __m256, dz: __m256, reach: __m256, used: u32) -> u32 {
-        // The same expression, in the same order, as `super::overlap_mask`.
-        let d2 = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
-            _mm256_mul_ps(dz, dz),
+    fn within(sq: __m256, r: &[f32; LANES], rp: f32, slack: f32, used: u32) -> u32 {
+        let reach = _mm256_add_ps(
+            _mm256_add_ps(load(r), _mm256_set1_ps(rp)),
+            _mm256_set1_ps(slack),
         );
         let rr = _mm256_mul_ps(reach, _mm256_set1_ps(GROW));
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(d2, _mm256_mul_ps(rr, rr))) as u32 & used
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(sq, _mm256_mul_ps(rr, rr))) as u32 & used
     }
 
     #[target_feature(enable = "avx2,fma")]
@@ -290,49 +286,20 @@ mod avx2 {
         slack: f32,
         used: u32,
     ) -> u32 {
-        mask(
-            _mm256_sub_ps(load(x), _mm256_set1_ps(p.x)),
-            _mm256_sub_ps(load(y), _mm256_set1_ps(p.y)),
-            _mm256_sub_ps(load(z), _mm256_set1_ps(p.z)),
-            _mm256_add_ps(
-                _mm256_add_ps(load(r), _mm256_set1_ps(rp)),
-                _mm256_set1_ps(slack),
-            ),
-            used,
-        )
+        let dx = _mm256_sub_ps(load(x), _mm256_set1_ps(p.x));
+        let dy = _mm256_sub_ps(load(y), _mm256_set1_ps(p.y));
+        let dz = _mm256_sub_ps(load(z), _mm256_set1_ps(p.z));
+        let d2 = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+            _mm256_mul_ps(dz, dz),
+        );
+        within(d2, r, rp, slack, used)
     }
 
+    /// The lower bound of |A + (E − A)·t|² over the step, as `super::swept_mask` computes it,
+    /// against the contact distance.
     #[target_feature(enable = "avx2,fma")]
-    fn block(
-        a: &Chunk,
-        [x, y, z]: [&[f32; LANES]; 3],
-        rb: &[f32; LANES],
-        slack: f32,
-        used_b: u32,
-    ) -> Block {
-        let (x, y, z, r) = (load(x), load(y), load(z), load(rb));
-        let slack = _mm256_set1_ps(slack);
-        let mut out = Block {
-            rows: [0; LANES],
-            any: 0,
-        };
-        for k in 0..LANES {
-            let m = mask(
-                _mm256_sub_ps(x, _mm256_set1_ps(a.x[k])),
-                _mm256_sub_ps(y, _mm256_set1_ps(a.y[k])),
-                _mm256_sub_ps(z, _mm256_set1_ps(a.z[k])),
-                _mm256_add_ps(_mm256_add_ps(r, _mm256_set1_ps(a.r[k])), slack),
-                used_b,
-            );
-            out.rows[k] = m;
-            out.any |= ((m != 0) as u32) << k;
-        }
-        out
-    }
-
-    /// The lower bound of |A + (E − A)·t|² over the step, as `super::swept_mask` computes it.
-    #[target_feature(enable = "avx2,fma")]
-    fn swept_lo(s: &SweptChunk, p0: Vec3, p1: Vec3) -> __m256 {
+    fn swept_mask(s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
         let sign = _mm256_set1_ps(-0.0);
         let mut lo = _mm256_setzero_ps();
         for (axis, (q0, q1)) in [(p0.x, p1.x), (p0.y, p1.y), (p0.z, p1.z)]
@@ -346,33 +313,7 @@ mod avx2 {
             let m = _mm256_and_ps(near, same);
             lo = _mm256_add_ps(lo, _mm256_mul_ps(m, m));
         }
-        lo
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn swept_mask(s: &SweptChunk, p0: Vec3, p1: Vec3, rp: f32, slack: f32, used: u32) -> u32 {
-        let lo = swept_lo(s, p0, p1);
-        let reach = _mm256_add_ps(
-            _mm256_add_ps(load(&s.r), _mm256_set1_ps(rp)),
-            _mm256_set1_ps(slack),
-        );
-        let rr = _mm256_mul_ps(reach, _mm256_set1_ps(GROW));
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(lo, _mm256_mul_ps(rr, rr))) as u32 & used
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    fn swept_block(a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
-        let mut out = Block {
-            rows: [0; LANES],
-            any: 0,
-        };
-        for k in 0..LANES {
-            let (p0, p1, r) = a.lane(k);
-            let m = swept_mask(b, p0, p1, r, slack, used_b);
-            out.rows[k] = m;
-            out.any |= ((m != 0) as u32) << k;
-        }
-        out
+        within(lo, &s.r, rp, slack, used)
     }
 
     impl Lanes for Avx2 {
@@ -391,19 +332,6 @@ mod avx2 {
         }
 
         #[inline(always)]
-        fn block(
-            self,
-            a: &Chunk,
-            b: [&[f32; LANES]; 3],
-            rb: &[f32; LANES],
-            slack: f32,
-            used_b: u32,
-        ) -> Block {
-            // SAFETY: as above.
-            unsafe { block(a, b, rb, slack, used_b) }
-        }
-
-        #[inline(always)]
         fn swept_mask(
             self,
             s: &SweptChunk,
@@ -415,12 +343,6 @@ mod avx2 {
         ) -> u32 {
             // SAFETY: as above.
             unsafe { swept_mask(s, p0, p1, rp, slack, used) }
-        }
-
-        #[inline(always)]
-        fn swept_block(self, a: &SweptChunk, b: &SweptChunk, slack: f32, used_b: u32) -> Block {
-            // SAFETY: as above.
-            unsafe { swept_block(a, b, slack, used_b) }
         }
     }
 }

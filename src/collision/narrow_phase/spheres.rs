@@ -150,22 +150,9 @@ impl<F: FnMut(usize, usize, f32)> LaneTask for Descent<'_, F> {
                 let ca = &ta.chunks[rca.start as usize];
                 let cb = &tb.chunks[rcb.start as usize];
                 let xb = cache.get_ref(rcb.start as usize, || rel.apply_chunk(cb));
-                let (ma, mb) = if ca.leaves == ca.used() && cb.leaves == cb.used() {
-                    // Among leaves the cross tests would rarely drop a pair: skipped.
-                    (ca.used(), cb.used())
-                } else {
-                    (
-                        lanes.overlap_mask(
-                            xyz3(&[ca.x, ca.y, ca.z]),
-                            &ca.r,
-                            it.b,
-                            it.rb,
-                            slack,
-                            ca.used(),
-                        ),
-                        lanes.overlap_mask(xyz3(xb), &cb.r, it.a, it.ra, slack, cb.used()),
-                    )
-                };
+                let xa = [&ca.x, &ca.y, &ca.z];
+                let ma = lanes.overlap_mask(xa, &ca.r, it.b, it.rb, slack, ca.used());
+                let mb = lanes.overlap_mask(xyz3(xb), &cb.r, it.a, it.ra, slack, cb.used());
                 let block = lanes.block(ca, xyz3(xb), &cb.r, slack, mb);
                 for k in bits(block.any & ma) {
                     let a = Vec3::new(ca.x[k], ca.y[k], ca.z[k]);
