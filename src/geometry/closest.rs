@@ -177,14 +177,15 @@ pub fn segment_triangle_crossing(p: Vec3, q: Vec3, t: &[Vec3; 3]) -> Option<Vec3
 /// and both points are a point where an edge of one crosses the other.
 ///
 /// For disjoint triangles the minimum is reached between two edges or between a vertex and the
-/// other's face (Ericson 5.1.9). The nine edge pairs come first, in f64: an edge pair whose closest
-/// points P, Q leave each triangle's third vertex on its own side of the slab between the planes
-/// through P and Q normal to Q − P is the answer at once (the slab separates the triangles; Larsen
-/// and Gottschalk's test in PQP). Otherwise a vertex of one triangle is the answer when the whole
-/// triangle lies on one side of the other's plane and that nearest vertex projects into the other
-/// face; otherwise, if some axis showed the triangles apart, the best edge pair is. Triangles not
-/// shown apart touch or intersect and take the exhaustive path (every vertex–face and edge–edge
-/// pair, and a crossing point).
+/// other's face (Ericson 5.1.9). A vertex of one triangle comes first: when the whole triangle
+/// lies on one side of the other's plane and its vertex nearest that plane projects into the
+/// other face, that vertex and its projection are the answer (no point of the triangle is nearer
+/// the plane). Then the nine edge pairs, in f64: an edge pair whose closest points P, Q leave
+/// each triangle's third vertex on its own side of the slab between the planes through P and Q
+/// normal to Q − P is the answer at once (the slab separates the triangles; Larsen and
+/// Gottschalk's test in PQP); otherwise, if some axis showed the triangles apart, the best edge
+/// pair is. Triangles not shown apart touch or intersect and take the exhaustive path (every
+/// vertex–face and edge–edge pair, and a crossing point).
 pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
     let s = t1.map(|v| v.as_dvec3());
     let t = t2.map(|v| v.as_dvec3());
@@ -194,6 +195,16 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
         on_second: q.as_vec3(),
     };
     let mut shown_apart = false;
+    for (first, other, swapped) in [(&s, &t, false), (&t, &s, true)] {
+        if let Some((point, on_face)) = vertex_over_face(first, other, &mut shown_apart) {
+            let (p, q) = if swapped {
+                (point, on_face)
+            } else {
+                (on_face, point)
+            };
+            return pair(p.distance_squared(q), p, q);
+        }
+    }
     let mut best = (f64::INFINITY, s[0], t[0]);
     for i in 0..3 {
         for j in 0..3 {
@@ -213,16 +224,6 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
                     shown_apart = true;
                 }
             }
-        }
-    }
-    for (first, other, swapped) in [(&s, &t, false), (&t, &s, true)] {
-        if let Some((point, on_face)) = vertex_over_face(first, other, &mut shown_apart) {
-            let (p, q) = if swapped {
-                (point, on_face)
-            } else {
-                (on_face, point)
-            };
-            return pair(p.distance_squared(q), p, q);
         }
     }
     if shown_apart {

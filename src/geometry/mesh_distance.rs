@@ -8,6 +8,9 @@
 //!   overlapping; its `penetration` is the largest distance from a vertex or triangle centroid of
 //!   one mesh lying inside the other to that other's surface: a lower bound of the true penetration
 //!   depth that is exact when the deepest point is a vertex (the usual case for convex tips).
+//! - [`mesh_penetration_near`] gives the same estimate from the triangles at the contact, walking
+//!   only the part of each surface that lies inside the other (see its doc for why that finds
+//!   every sample point the whole-mesh search would).
 
 use glam::{Mat3, Vec3};
 
@@ -18,6 +21,7 @@ use super::{
         TrianglePair, closest_point_triangle, closest_points_triangle_triangle, triangle_plane_gap,
     },
     pose::Pose,
+    stars::VertexStars,
     trimesh::TriMesh,
 };
 
@@ -340,6 +344,127 @@ pub fn mesh_penetration(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) ->
     if da >= db { (da, pa, qa) } else { (db, qb, pb) }
 }
 
+/// One side of [`mesh_penetration_near`]: a mesh, its vertex stars, and triangles of it that
+/// include every triangle meeting the other mesh's surface.
+#[derive(Clone, Copy)]
+pub struct NearContact<'a> {
+    /// The mesh with its hierarchy.
+    pub mesh: MeshRef<'a>,
+    /// Its vertex stars ([`VertexStars::of`] the same mesh).
+    pub stars: &'a VertexStars,
+    /// Triangle indices: every triangle that meets the other surface must be among them (more
+    /// are allowed).
+    pub near: &'a [u32],
+}
+
+/// [`mesh_penetration`] found from the contact: the same estimate (the deepest vertex or triangle
+/// centroid of either mesh inside the other), sampling only the part of each surface that lies
+/// inside the other.
+///
+/// Why that finds every sample point inside the other mesh: a vertex inside with a neighbour
+/// outside ends an edge that crosses the other surface, so the triangles on that edge meet the
+/// other surface and are among `near`; the vertices inside connect to such a vertex through
+/// vertices inside, unless their whole piece of the mesh is inside (each piece's first vertex is
+/// therefore tested too). A triangle with its centroid inside has a corner inside, reached by the
+/// walk, or crosses the other surface and is among `near`. The walk starts at the corners and
+/// centroids of `near` and spreads from each vertex found inside to the triangles around it.
+pub fn mesh_penetration_near(
+    a: NearContact,
+    pose_a: &Pose,
+    b: NearContact,
+    pose_b: &Pose,
+) -> (f32, Vec3, Vec3) {
+    let (da, pa, qa) = Walk::new(&a, pose_a, b.mesh, pose_b).deepest();
+    let (db, pb, qb) = Walk::new(&b, pose_b, a.mesh, pose_a).deepest();
+    if da >= db { (da, pa, qa) } else { (db, qb, pb) }
+}
+
+/// The walk of [`mesh_penetration_near`] over one mesh's part inside the other.
+struct Walk<'a> {
+    a: NearContact<'a>,
+    b: MeshRef<'a>,
+    a_in_b: Pose,
+    pose_b: Pose,
+    b_box: Aabb,
+    seen_vertex: Vec<bool>,
+    seen_triangle: Vec<bool>,
+    inside: Vec<u32>,
+    /// Depth, deepest point (b's frame) and its nearest point on b's surface (b's frame).
+    best: (f32, Vec3, Vec3),
+}
+
+impl<'a> Walk<'a> {
+    fn new(a: &NearContact<'a>, pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
+        let origin = pose_b.inverse().transform_point(pose_a.translation);
+        Self {
+            a: *a,
+            b,
+            a_in_b: pose_b.inverse().mul(pose_a),
+            pose_b: *pose_b,
+            b_box: b.bvh.root_aabb(),
+            seen_vertex: vec![false; a.mesh.mesh.vertices.len()],
+            seen_triangle: vec![false; a.mesh.mesh.triangles.len()],
+            inside: Vec::new(),
+            best: (0.0, origin, origin),
+        }
+    }
+
+    /// Depth, point (world) and nearest point of b's surface (world), as [`deepest_point`].
+    fn deepest(mut self) -> (f32, Vec3, Vec3) {
+        for &t in self.a.near {
+            self.triangle(t);
+        }
+        for &v in self.a.stars.pieces() {
+            self.vertex(v);
+        }
+        while let Some(v) = self.inside.pop() {
+            for &t in self.a.stars.around(v as usize) {
+                self.triangle(t);
+            }
+        }
+        let (d, p, q) = self.best;
+        (
+            d,
+            self.pose_b.transform_point(p),
+            self.pose_b.transform_point(q),
+        )
+    }
+
+    fn triangle(&mut self, t: u32) {
+        if std::mem::replace(&mut self.seen_triangle[t as usize], true) {
+            return;
+        }
+        let [p, q, r] = self.a.mesh.mesh.triangle(t as usize);
+        self.sample((p + q + r) / 3.0);
+        for v in self.a.mesh.mesh.triangles[t as usize] {
+            self.vertex(v);
+        }
+    }
+
+    fn vertex(&mut self, v: u32) {
+        if std::mem::replace(&mut self.seen_vertex[v as usize], true) {
+            return;
+        }
+        if self.sample(self.a.mesh.mesh.vertices[v as usize]) {
+            self.inside.push(v);
+        }
+    }
+
+    /// Whether the point of a (local frame) lies inside b; the deepest so far is kept.
+    fn sample(&mut self, local: Vec3) -> bool {
+        let p = self.a_in_b.transform_point(local);
+        if self.b_box.distance_squared_to_point(p) > 0.0 || !point_inside_mesh(self.b, p) {
+            return false;
+        }
+        if let Some((q, d)) = closest_point_on_mesh(self.b, p)
+            && d > self.best.0
+        {
+            self.best = (d, p, q);
+        }
+        true
+    }
+}
+
 /// The deepest sample point of `a` (vertices and triangle centroids) inside `b`: its depth, the point
 /// (world) and the nearest point of b's surface (world).
 fn deepest_point(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, Vec3, Vec3) {
@@ -428,6 +553,110 @@ mod tests {
         );
         assert!(s.overlapping());
         assert!(s.penetration > 3.5, "{s:?}");
+    }
+
+    /// Triangles of `a` (posed) that meet `b`'s surface, by testing every pair.
+    fn meeting(a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pose) -> Vec<u32> {
+        let world =
+            |m: &TriMesh, pose: &Pose, i: usize| m.triangle(i).map(|v| pose.transform_point(v));
+        let boxes = |m: &TriMesh, pose: &Pose| -> Vec<Aabb> {
+            (0..m.triangles.len())
+                .map(|i| Aabb::from_points(world(m, pose, i)))
+                .collect()
+        };
+        let (boxes_a, boxes_b) = (boxes(a, pose_a), boxes(b, pose_b));
+        (0..a.triangles.len() as u32)
+            .filter(|&i| {
+                let ta = world(a, pose_a, i as usize);
+                (0..b.triangles.len()).any(|j| {
+                    boxes_a[i as usize].distance_squared(&boxes_b[j]) <= 0.0
+                        && crate::geometry::triangles_intersect(&ta, &world(b, pose_b, j))
+                })
+            })
+            .collect()
+    }
+
+    /// The walk from the contact finds the same deepest sample as the whole-mesh search, for two
+    /// real teeth overlapping by up to most of their size, and for a box wholly inside another
+    /// (no triangle meets the other surface there: the walk starts from each piece's vertex).
+    #[test]
+    fn penetration_from_the_contact_matches_the_whole_mesh_search() {
+        use crate::teeth::{Arch, ToothGeometry, ToothKind, ToothResolution};
+        let a =
+            ToothGeometry::procedural(Arch::Lower, ToothKind::FirstMolar, ToothResolution::PAPER);
+        let b = ToothGeometry::procedural(
+            Arch::Upper,
+            ToothKind::SecondPremolar,
+            ToothResolution::PAPER,
+        );
+        let mut n = crate::geometry::test_numbers(41);
+        let mut deep = 0;
+        for case in 0..60 {
+            let pose_a = Pose::new(
+                Quat::from_euler(glam::EulerRot::XYZ, n() * 6.0, n() * 6.0, n() * 6.0),
+                Vec3::new(n(), n(), n()) * 20.0,
+            );
+            let offset = Vec3::new(n(), n() + 0.5, n()) * 2.0 * (2.0 + 8.0 * (case as f32 / 60.0));
+            let pose_b = Pose::new(
+                Quat::from_euler(glam::EulerRot::XYZ, n() * 6.0, n() * 6.0, n() * 6.0),
+                pose_a.transform_point(offset),
+            );
+            let (near_a, near_b) = (
+                meeting(&a.mesh, &pose_a, &b.mesh, &pose_b),
+                meeting(&b.mesh, &pose_b, &a.mesh, &pose_a),
+            );
+            let whole = mesh_penetration(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b);
+            let walked = mesh_penetration_near(
+                NearContact {
+                    mesh: a.mesh_ref(),
+                    stars: &a.stars,
+                    near: &near_a,
+                },
+                &pose_a,
+                NearContact {
+                    mesh: b.mesh_ref(),
+                    stars: &b.stars,
+                    near: &near_b,
+                },
+                &pose_b,
+            );
+            assert_eq!(walked.0, whole.0, "case {case}");
+            if whole.0 > 0.0 {
+                assert_eq!((walked.1, walked.2), (whole.1, whole.2), "case {case}");
+            }
+            deep += (whole.0 > 0.5) as usize;
+        }
+        assert!(deep > 20, "{deep} deep overlaps");
+
+        let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
+        let (small, small_bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+        let (big_stars, small_stars) = (VertexStars::of(&big), VertexStars::of(&small));
+        let side = |mesh, bvh, stars| NearContact {
+            mesh: MeshRef { mesh, bvh },
+            stars,
+            near: &[],
+        };
+        let pose = Pose::new(Quat::from_rotation_y(0.3), Vec3::ZERO);
+        let walked = mesh_penetration_near(
+            side(&big, &big_bvh, &big_stars),
+            &Pose::IDENTITY,
+            side(&small, &small_bvh, &small_stars),
+            &pose,
+        );
+        let whole = mesh_penetration(
+            MeshRef {
+                mesh: &big,
+                bvh: &big_bvh,
+            },
+            &Pose::IDENTITY,
+            MeshRef {
+                mesh: &small,
+                bvh: &small_bvh,
+            },
+            &pose,
+        );
+        assert!(walked.0 > 3.5, "{walked:?}");
+        assert_eq!(walked, whole);
     }
 
     #[test]

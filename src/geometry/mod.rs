@@ -14,6 +14,7 @@ pub mod mass;
 pub mod mesh_distance;
 pub mod pose;
 pub mod sphere;
+pub mod stars;
 pub mod trimesh;
 
 pub use aabb::Aabb;
@@ -24,9 +25,12 @@ pub use closest::{
 };
 pub use columns::Columns;
 pub use mass::MassProperties;
-pub use mesh_distance::{MeshRef, MeshSeparation, mesh_penetration, mesh_separation};
+pub use mesh_distance::{
+    MeshRef, MeshSeparation, NearContact, mesh_penetration, mesh_penetration_near, mesh_separation,
+};
 pub use pose::Pose;
 pub use sphere::Sphere;
+pub use stars::VertexStars;
 pub use trimesh::{MeshError, TriMesh};
 
 /// The geometry tests' seeded source of uniform numbers in [−0.5, 0.5) (a linear congruential

@@ -12,7 +12,7 @@ use super::{
     memo::Memo,
     shape::{ToothResolution, ToothSolid},
 };
-use crate::geometry::{MeshRef, TriMesh, TriangleBvh};
+use crate::geometry::{MeshRef, TriMesh, TriangleBvh, VertexStars};
 
 /// The geometry of one tooth in its local frame (see [`super::shape`] for the frame).
 #[derive(Debug)]
@@ -27,6 +27,8 @@ pub struct ToothGeometry {
     pub mesh: TriMesh,
     /// Triangle hierarchy for exact queries.
     pub bvh: TriangleBvh,
+    /// The triangles around each vertex (for walks over the surface from a contact).
+    pub stars: VertexStars,
     /// Data computed from the mesh.
     pub frame: ToothFrame,
     /// Cusp tips and incisal points in the local frame (for occlusion measures).
@@ -61,6 +63,7 @@ impl ToothGeometry {
             CentreParameters::default(),
         );
         let bvh = TriangleBvh::build(&mesh);
+        let stars = VertexStars::of(&mesh);
         Self {
             arch,
             kind,
@@ -68,6 +71,7 @@ impl ToothGeometry {
             cusp_tips,
             mesh,
             bvh,
+            stars,
             frame,
         }
     }

@@ -38,7 +38,9 @@
 //! lower bound): it cannot have shrunk by more than μ·Δt, so pairs whose carried bound exceeds
 //! the best distance of the step are not measured again (the minimum is unchanged, only cheaper).
 //! Teeth already interpenetrating at t = 0 report time 0 and the penetration depth of the whole
-//! meshes. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
+//! meshes ([`mesh_penetration_near`]: the candidate triangles hold every triangle that crosses
+//! the other surface, so the search walks from them over the part of each surface inside the
+//! other instead of testing every vertex). After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
 //! conservative, time is reported with its gap.
 //!
 //! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
@@ -48,7 +50,9 @@ use glam::Vec3;
 use super::lanes::Affine32;
 use super::{Body, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion, NodeCache};
-use crate::geometry::{FacePlane, MeshRef, closest_points_triangle_triangle, mesh_penetration};
+use crate::geometry::{
+    FacePlane, NearContact, closest_points_triangle_triangle, mesh_penetration_near,
+};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -399,15 +403,18 @@ fn advance_with(
             if d == 0.0 {
                 // Touching or interpenetrating (only possible at the start): the candidates
                 // already touch, so only the depth is left to find.
-                let (depth, pa, pb) = mesh_penetration(
-                    MeshRef {
-                        mesh: ma,
-                        bvh: &a.shape.geometry.bvh,
+                let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+                let (depth, pa, pb) = mesh_penetration_near(
+                    NearContact {
+                        mesh: ga.mesh_ref(),
+                        stars: &ga.stars,
+                        near: &ids_a,
                     },
                     &pose_a,
-                    MeshRef {
-                        mesh: mb,
-                        bvh: &b.shape.geometry.bvh,
+                    NearContact {
+                        mesh: gb.mesh_ref(),
+                        stars: &gb.stars,
+                        near: &ids_b,
                     },
                     &pose_b,
                 );
