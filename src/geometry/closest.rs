@@ -177,16 +177,27 @@ pub fn segment_triangle_crossing(p: Vec3, q: Vec3, t: &[Vec3; 3]) -> Option<Vec3
 /// and both points are a point where an edge of one crosses the other.
 ///
 /// For disjoint triangles the minimum is reached between two edges or between a vertex and the
-/// other's face (Ericson 5.1.9). A vertex of one triangle comes first: when the whole triangle
-/// lies on one side of the other's plane and its vertex nearest that plane projects into the
-/// other face, that vertex and its projection are the answer (no point of the triangle is nearer
-/// the plane). Then the nine edge pairs, in f64: an edge pair whose closest points P, Q leave
-/// each triangle's third vertex on its own side of the slab between the planes through P and Q
-/// normal to Q − P is the answer at once (the slab separates the triangles; Larsen and
-/// Gottschalk's test in PQP); otherwise, if some axis showed the triangles apart, the best edge
-/// pair is. Triangles not shown apart touch or intersect and take the exhaustive path (every
-/// vertex–face and edge–edge pair, and a crossing point).
+/// other's face (Ericson 5.1.9). The nine edge pairs come first, in f64: an edge pair whose closest
+/// points P, Q leave each triangle's third vertex on its own side of the slab between the planes
+/// through P and Q normal to Q − P is the answer at once (the slab separates the triangles; Larsen
+/// and Gottschalk's test in PQP). Otherwise a vertex of one triangle is the answer when the whole
+/// triangle lies on one side of the other's plane and that nearest vertex projects into the other
+/// face (no point of the triangle is nearer the plane); otherwise, if some axis showed the
+/// triangles apart, the best edge pair is. Triangles not shown apart touch or intersect and take
+/// the exhaustive path (every vertex–face and edge–edge pair, and a crossing point).
 pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
+    closest_points(t1, t2, false)
+}
+
+/// [`closest_points_triangle_triangle`] with the vertex over the other face tried before the
+/// edge pairs: the same answer, sooner for triangles known to face each other (one wholly beyond
+/// the other's plane, where the vertex is usually the answer), later for others.
+pub fn closest_points_facing_triangles(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> TrianglePair {
+    closest_points(t1, t2, true)
+}
+
+#[inline(always)]
+fn closest_points(t1: &[Vec3; 3], t2: &[Vec3; 3], vertex_first: bool) -> TrianglePair {
     let s = t1.map(|v| v.as_dvec3());
     let t = t2.map(|v| v.as_dvec3());
     let pair = |d2: f64, p: DVec3, q: DVec3| TrianglePair {
@@ -195,15 +206,21 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
         on_second: q.as_vec3(),
     };
     let mut shown_apart = false;
-    for (first, other, swapped) in [(&s, &t, false), (&t, &s, true)] {
-        if let Some((point, on_face)) = vertex_over_face(first, other, &mut shown_apart) {
-            let (p, q) = if swapped {
-                (point, on_face)
-            } else {
-                (on_face, point)
-            };
-            return pair(p.distance_squared(q), p, q);
+    let vertex_over_faces = |shown_apart: &mut bool| {
+        for (first, other, swapped) in [(&s, &t, false), (&t, &s, true)] {
+            if let Some((point, on_face)) = vertex_over_face(first, other, shown_apart) {
+                let (p, q) = if swapped {
+                    (point, on_face)
+                } else {
+                    (on_face, point)
+                };
+                return Some(pair(p.distance_squared(q), p, q));
+            }
         }
+        None
+    };
+    if vertex_first && let Some(answer) = vertex_over_faces(&mut shown_apart) {
+        return answer;
     }
     let mut best = (f64::INFINITY, s[0], t[0]);
     for i in 0..3 {
@@ -225,6 +242,9 @@ pub fn closest_points_triangle_triangle(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> Trian
                 }
             }
         }
+    }
+    if !vertex_first && let Some(answer) = vertex_over_faces(&mut shown_apart) {
+        return answer;
     }
     if shown_apart {
         return pair(best.0, best.1, best.2);
@@ -545,7 +565,6 @@ mod tests {
         assert!(by_kind.iter().all(|&k| k > 100), "{by_kind:?}");
 
         fn check(a: &[Vec3; 3], b: &[Vec3; 3], by_kind: &mut [usize; 3]) {
-            let fast = closest_points_triangle_triangle(a, b);
             // Reference: 0 where an edge crosses the other triangle, else the nearest of the
             // vertex–face and edge–edge pairs.
             let crossing = (0..3).any(|k| {
@@ -575,15 +594,21 @@ mod tests {
                 slow.distance = features;
             }
             let tol = 1e-5 * (1.0 + slow.distance);
-            assert!(
-                (fast.distance - slow.distance).abs() <= tol,
-                "{a:?} {b:?}: {fast:?} vs {slow:?}"
-            );
-            // The points are on their triangles and as far apart as reported.
-            assert!((fast.on_first.distance(fast.on_second) - fast.distance).abs() <= tol);
-            for (p, t) in [(fast.on_first, a), (fast.on_second, b)] {
-                let q = closest_point_triangle(p, t[0], t[1], t[2]);
-                assert!(q.distance(p) <= 1e-5, "{p} off {t:?}");
+            // Both orders of the fast search.
+            for fast in [
+                closest_points_triangle_triangle(a, b),
+                closest_points_facing_triangles(a, b),
+            ] {
+                assert!(
+                    (fast.distance - slow.distance).abs() <= tol,
+                    "{a:?} {b:?}: {fast:?} vs {slow:?}"
+                );
+                // The points are on their triangles and as far apart as reported.
+                assert!((fast.on_first.distance(fast.on_second) - fast.distance).abs() <= tol);
+                for (p, t) in [(fast.on_first, a), (fast.on_second, b)] {
+                    let q = closest_point_triangle(p, t[0], t[1], t[2]);
+                    assert!(q.distance(p) <= 1e-5, "{p} off {t:?}");
+                }
             }
             by_kind[if slow.distance == 0.0 {
                 0

@@ -20,8 +20,9 @@ pub mod trimesh;
 pub use aabb::Aabb;
 pub use bvh::TriangleBvh;
 pub use closest::{
-    FacePlane, TrianglePair, closest_point_triangle, closest_points_segment_segment,
-    closest_points_triangle_triangle, plane_gap, triangle_plane_gap, triangles_intersect,
+    FacePlane, TrianglePair, closest_point_triangle, closest_points_facing_triangles,
+    closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,
+    triangle_plane_gap, triangles_intersect,
 };
 pub use columns::Columns;
 pub use mass::MassProperties;

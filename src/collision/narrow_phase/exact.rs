@@ -51,7 +51,7 @@ use super::lanes::Affine32;
 use super::{Body, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion, NodeCache};
 use crate::geometry::{
-    FacePlane, NearContact, closest_points_triangle_triangle, mesh_penetration_near,
+    FacePlane, NearContact, closest_points_facing_triangles, mesh_penetration_near,
 };
 
 /// Largest gap left between teeth reported as touching (mm).
@@ -368,7 +368,8 @@ fn advance_with(
                 c.d = lb;
                 return;
             }
-            let p = closest_points_triangle_triangle(&tx.v, &ty.v);
+            // The pairs measured are the nearest candidates, mostly facing each other.
+            let p = closest_points_facing_triangles(&tx.v, &ty.v);
             c.d = p.distance;
             if p.distance < best.0 {
                 best = (p.distance, p.on_first, p.on_second);
