@@ -104,11 +104,12 @@ impl Motion {
         if theta <= 0.0 {
             return self.travel();
         }
-        let k = self.axis();
-        let r0 = dquat(self.start.rotation);
+        // |k × R₀p| = |R₀⁻¹k × p|: the axis taken into the local frame once.
+        let k = dquat(self.start.rotation).inverse() * self.axis();
         let far = points
-            .map(|p| k.cross(r0 * p.as_dvec3()).length())
-            .fold(0.0, f64::max);
+            .map(|p| k.cross(p.as_dvec3()).length_squared())
+            .fold(0.0, f64::max)
+            .sqrt();
         // The axis is rounded in f64: widen by far more than its error.
         self.travel() + theta * far * (1.0 + 1e-9)
     }
@@ -180,13 +181,6 @@ impl<T: Copy + Default> NodeCache<T> {
             self.values[i] = f();
             self.stamps[i] = self.now;
         }
-        &self.values[i]
-    }
-
-    /// The value of node `i`, already computed in this query.
-    #[inline]
-    pub(crate) fn cached(&self, i: usize) -> &T {
-        debug_assert_eq!(self.stamps[i], self.now);
         &self.values[i]
     }
 

@@ -13,15 +13,17 @@
 //! only the leaf pairs whose swept spheres meet within it, so a long step does not drag every leaf
 //! pair of its whole sweep into the triangle stage.
 //!
-//! Advancement: the candidate triangle pairs are listed once each (leaf pairs share triangles), in
-//! the order of their leaf pairs' distance at the start of the window. From the earliest leaf
+//! Advancement: the candidate triangle pairs are listed once each (leaf pairs share triangles,
+//! so each leaf pair marks its pairs in a bit matrix), the triangles numbered in the order of
+//! their leaf pairs' distance at the start of the window. From the earliest leaf
 //! time, each step computes a lower bound d on the distance between the candidate triangles at the
 //! current poses: the exact distance of every candidate pair that three cheap lower bounds cannot
 //! already show farther than the best so far: the triangles' bounding spheres, their projections
 //! on the direction between the previous step's closest points (or between the nearest leaf
 //! pair's centres), and the plane gap (one triangle wholly beyond the other's plane, nearly exact
-//! for the facing triangles of teeth in contact). The previous step's nearest pair is measured
-//! first, so the best is small from the start and the bounds cull the rest. The minimum over all
+//! for the facing triangles of teeth in contact). The previous step's nearest pair (in the first
+//! step, the pair with the nearest centres) is measured first, so the best is small from the
+//! start and the bounds cull the rest. The minimum over all
 //! candidate pairs is a lower bound on the distance of whichever pair touches first (that pair
 //! is a candidate). No point of the candidates
 //! moves faster than μ = Σ (origin travel + rotation angle × farthest candidate vertex from the
@@ -71,17 +73,24 @@ struct PlacedTri {
     v: [Vec3; 3],
     centre: Vec3,
     radius: f32,
+    /// |centre| + radius: no vertex is farther from the origin.
+    reach: f32,
     plane: FacePlane,
 }
 
 impl PlacedTri {
     fn new(v: [Vec3; 3]) -> Self {
         let centre = (v[0] + v[1] + v[2]) / 3.0;
-        let radius = v.iter().map(|p| p.distance(centre)).fold(0.0f32, f32::max);
+        let radius = v
+            .iter()
+            .map(|p| p.distance_squared(centre))
+            .fold(0.0f32, f32::max)
+            .sqrt();
         Self {
             v,
             centre,
             radius,
+            reach: centre.length() + radius,
             plane: FacePlane::of(&v),
         }
     }
@@ -97,10 +106,7 @@ impl PlacedTri {
         let (p_lo, p_hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
         let (q_lo, q_hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
         let g = (q_lo - p_hi).max(p_lo - q_hi);
-        if g <= 0.0 {
-            return 0.0;
-        }
-        let margin = 4e-7 * (self.centre.length() + self.radius + o.centre.length() + o.radius);
+        let margin = 4e-7 * (self.reach + o.reach);
         (g - margin).max(0.0) * (1.0 - 1e-6)
     }
 
@@ -108,13 +114,10 @@ impl PlacedTri {
     /// with each plane computed once per step and its rounding margin taken from the bounding
     /// spheres (which bound the triangles' spread and their distance from the origin).
     #[inline]
-    fn gap_to(&self, o: &PlacedTri) -> f32 {
+    fn gap_to(&self, o: &PlacedTri, between: f32) -> f32 {
         let m = self.plane.beyond(&o.v).max(o.plane.beyond(&self.v));
-        if m <= 0.0 {
-            return 0.0;
-        }
-        let near = (self.centre.distance(o.centre) + self.radius + o.radius) as f64;
-        let far = (self.centre.length() + o.centre.length()) as f64 + near;
+        let near = (between + self.radius + o.radius) as f64;
+        let far = (self.reach + o.reach) as f64 + near;
         let margin = 1e-8 * near + 1e-14 * far;
         ((m - margin).max(0.0) as f32) * (1.0 - 1e-6)
     }
@@ -125,6 +128,10 @@ impl PlacedTri {
 struct Scratch {
     slot_a: NodeCache<u32>,
     slot_b: NodeCache<u32>,
+    leaf_a: NodeCache<(u32, u32)>,
+    leaf_b: NodeCache<(u32, u32)>,
+    local_a: Vec<u32>,
+    local_b: Vec<u32>,
     listed: Vec<u64>,
     candidates: Vec<Candidate>,
 }
@@ -148,6 +155,10 @@ thread_local! {
         std::cell::RefCell::new(Scratch {
             slot_a: NodeCache::new(),
             slot_b: NodeCache::new(),
+            leaf_a: NodeCache::new(),
+            leaf_b: NodeCache::new(),
+            local_a: Vec::new(),
+            local_b: Vec::new(),
             listed: Vec::new(),
             candidates: Vec::new(),
         })
@@ -236,6 +247,10 @@ fn advance_with(
     let Scratch {
         slot_a,
         slot_b,
+        leaf_a,
+        leaf_b,
+        local_a,
+        local_b,
         listed,
         candidates,
     } = scratch;
@@ -258,53 +273,84 @@ fn advance_with(
         })
         .collect();
     order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    // Candidate triangles of each side (ids_a / ids_b), numbered in order of first use.
+    // Candidate triangles of each side (ids_a / ids_b), numbered in order of first use; each
+    // leaf's triangles as those numbers, once per leaf (leaves recur in many leaf pairs), in
+    // `local_a` / `local_b` at the span its cache holds.
     slot_a.begin(ma.triangles.len());
     slot_b.begin(mb.triangles.len());
+    leaf_a.begin(ta.spheres.len());
+    leaf_b.begin(tb.spheres.len());
     let (mut ids_a, mut ids_b) = (Vec::new(), Vec::new());
-    let mut leaves: Vec<(&[u32], &[u32])> = Vec::with_capacity(order.len());
+    local_a.clear();
+    local_b.clear();
+    let number = |tree: &crate::collision::CompactTree,
+                  leaf: usize,
+                  slot: &mut NodeCache<u32>,
+                  ids: &mut Vec<u32>,
+                  local: &mut Vec<u32>| {
+        let at = local.len();
+        for &x in tree.triangles(leaf) {
+            local.push(slot.get(x as usize, || {
+                ids.push(x);
+                ids.len() as u32 - 1
+            }));
+        }
+        (at as u32, local.len() as u32)
+    };
+    let mut spans: Vec<((u32, u32), (u32, u32))> = Vec::with_capacity(order.len());
     for &(_, k) in &order {
         let (i, j, _) = swept.leaf_times[k];
-        let (xs, ys) = (ta.triangles(i as usize), tb.triangles(j as usize));
-        for &x in xs {
-            slot_a.get(x as usize, || {
-                ids_a.push(x);
-                ids_a.len() as u32 - 1
-            });
-        }
-        for &y in ys {
-            slot_b.get(y as usize, || {
-                ids_b.push(y);
-                ids_b.len() as u32 - 1
-            });
-        }
-        leaves.push((xs, ys));
+        let xs = leaf_a.get(i as usize, || {
+            number(ta, i as usize, slot_a, &mut ids_a, local_a)
+        });
+        let ys = leaf_b.get(j as usize, || {
+            number(tb, j as usize, slot_b, &mut ids_b, local_b)
+        });
+        spans.push((xs, ys));
     }
-    // Candidate triangle pairs, each once (leaf pairs share triangles), in the leaves' order.
-    let ny = ids_b.len();
-    let words = (ids_a.len() * ny).div_ceil(64);
+    // Candidate triangle pairs, each once (leaf pairs share triangles): marked in a bit matrix
+    // (a row of b's numbers for each of a's), then listed row by row; near leaf pairs' triangles
+    // have the low numbers, so they come first. Rows of up to 64 take one word per leaf pair and
+    // triangle of a.
+    let (nx, ny) = (ids_a.len(), ids_b.len());
+    let row_words = ny.div_ceil(64);
+    let words = nx * row_words;
     if listed.len() < words {
         listed.resize(words, 0);
     }
     listed[..words].fill(0);
-    candidates.clear();
-    for (xs, ys) in leaves {
-        for &x in xs {
-            let xi = *slot_a.cached(x as usize);
-            for &y in ys {
-                let yi = *slot_b.cached(y as usize);
-                let key = xi as usize * ny + yi as usize;
-                let (word, bit) = (key / 64, 1u64 << (key % 64));
-                if listed[word] & bit == 0 {
-                    listed[word] |= bit;
-                    candidates.push(Candidate {
-                        x: xi,
-                        y: yi,
-                        d: f32::NEG_INFINITY,
-                        t,
-                    });
+    for &((x0, x1), (y0, y1)) in &spans {
+        let (xs, ys) = (
+            &local_a[x0 as usize..x1 as usize],
+            &local_b[y0 as usize..y1 as usize],
+        );
+        if row_words == 1 {
+            let mask = ys.iter().fold(0u64, |m, &yi| m | 1 << yi);
+            for &xi in xs {
+                listed[xi as usize] |= mask;
+            }
+        } else {
+            for &xi in xs {
+                let row = &mut listed[xi as usize * row_words..][..row_words];
+                for &yi in ys {
+                    row[yi as usize / 64] |= 1u64 << (yi % 64);
                 }
             }
+        }
+    }
+    candidates.clear();
+    for (w, &word) in listed[..words].iter().enumerate() {
+        let (xi, base) = (w / row_words, (w % row_words) * 64);
+        let mut bits = word;
+        while bits != 0 {
+            let yi = base + bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            candidates.push(Candidate {
+                x: xi as u32,
+                y: yi as u32,
+                d: f32::NEG_INFINITY,
+                t,
+            });
         }
     }
     let speed = |motion: &Motion, mesh: &crate::geometry::TriMesh, ids: &[u32]| {
@@ -352,18 +398,14 @@ fn advance_with(
             }
             c.t = t;
             let (tx, ty) = (&tris_a[c.x as usize], &tris_b[c.y as usize]);
-            let spheres = tx.centre.distance(ty.centre) - tx.radius - ty.radius;
-            if spheres >= best.0 {
-                c.d = spheres.max(0.0);
-                return;
-            }
-            let lb = tx.axis_gap(ty, axis);
+            let between = tx.centre.distance(ty.centre);
+            let lb = (between - tx.radius - ty.radius).max(tx.axis_gap(ty, axis));
             if lb >= best.0 {
-                c.d = lb;
+                c.d = lb.max(0.0);
                 return;
             }
             // Facing triangles: the plane gap is nearly the distance and far cheaper.
-            let lb = tx.gap_to(ty);
+            let lb = tx.gap_to(ty, between);
             if lb >= best.0 {
                 c.d = lb;
                 return;
@@ -376,6 +418,18 @@ fn advance_with(
                 best_k = Some(k);
             }
         };
+        if nearest.is_none() {
+            // First step: the pair whose bounding spheres are nearest is measured first.
+            nearest = candidates
+                .iter()
+                .enumerate()
+                .map(|(k, c)| {
+                    let (tx, ty) = (&tris_a[c.x as usize], &tris_b[c.y as usize]);
+                    (tx.centre.distance_squared(ty.centre), k)
+                })
+                .min_by(|x, y| x.0.total_cmp(&y.0))
+                .map(|x| x.1);
+        }
         if let Some(k) = nearest {
             look(k, &mut candidates[k]);
         }
