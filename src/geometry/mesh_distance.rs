@@ -201,8 +201,20 @@ pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
 /// True when `p` (mesh frame) lies inside the closed mesh: the parity of crossings along a ray,
 /// retried along other directions when a ray grazes an edge or vertex.
 pub fn point_inside_mesh(m: MeshRef, p: Vec3) -> bool {
+    point_inside_mesh_along(m, p, None)
+}
+
+/// [`point_inside_mesh`] casting its first ray along `first` (a unit vector with no component
+/// near zero; for example away from the mesh's middle, where a ray from a point near the
+/// surface meets few boxes), then along the fixed directions if that ray grazes an edge.
+fn point_inside_mesh_along(m: MeshRef, p: Vec3, first: Option<Vec3>) -> bool {
     if m.bvh.nodes.is_empty() || m.bvh.root_aabb().distance_squared_to_point(p) > 0.0 {
         return false;
+    }
+    if let Some(dir) = first
+        && let Some(inside) = ray_parity(m, p, dir)
+    {
+        return inside;
     }
     const DIRECTIONS: [Vec3; 4] = [
         Vec3::new(0.573_462_4, 0.608_519_3, 0.548_867_6),
@@ -453,7 +465,13 @@ impl<'a> Walk<'a> {
     /// Whether the point of a (local frame) lies inside b; the deepest so far is kept.
     fn sample(&mut self, local: Vec3) -> bool {
         let p = self.a_in_b.transform_point(local);
-        if self.b_box.distance_squared_to_point(p) > 0.0 || !point_inside_mesh(self.b, p) {
+        if self.b_box.distance_squared_to_point(p) > 0.0 {
+            return false;
+        }
+        // The sample is near b's surface: a ray away from b's middle leaves it at once.
+        let out = (p - self.b_box.centre()).normalize_or_zero();
+        let first = (out.abs().min_element() > 1e-3).then_some(out);
+        if !point_inside_mesh_along(self.b, p, first) {
             return false;
         }
         if let Some((q, d)) = closest_point_on_mesh(self.b, p)
