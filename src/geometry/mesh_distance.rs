@@ -394,30 +394,20 @@ pub fn mesh_penetration_near(
 /// The walk of [`mesh_penetration_near`] over one mesh's part inside the other.
 struct Walk<'a> {
     a: NearContact<'a>,
-    b: MeshRef<'a>,
-    a_in_b: Pose,
-    pose_b: Pose,
-    b_box: Aabb,
     seen_vertex: Vec<bool>,
     seen_triangle: Vec<bool>,
     inside: Vec<u32>,
-    /// Depth, deepest point (b's frame) and its nearest point on b's surface (b's frame).
-    best: (f32, Vec3, Vec3),
+    deepest: Deepest<'a>,
 }
 
 impl<'a> Walk<'a> {
     fn new(a: &NearContact<'a>, pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
-        let origin = pose_b.inverse().transform_point(pose_a.translation);
         Self {
             a: *a,
-            b,
-            a_in_b: pose_b.inverse().mul(pose_a),
-            pose_b: *pose_b,
-            b_box: b.bvh.root_aabb(),
             seen_vertex: vec![false; a.mesh.mesh.vertices.len()],
             seen_triangle: vec![false; a.mesh.mesh.triangles.len()],
             inside: Vec::new(),
-            best: (0.0, origin, origin),
+            deepest: Deepest::new(pose_a, b, pose_b),
         }
     }
 
@@ -434,12 +424,7 @@ impl<'a> Walk<'a> {
                 self.triangle(t);
             }
         }
-        let (d, p, q) = self.best;
-        (
-            d,
-            self.pose_b.transform_point(p),
-            self.pose_b.transform_point(q),
-        )
+        self.deepest.result()
     }
 
     fn triangle(&mut self, t: u32) {
@@ -447,7 +432,7 @@ impl<'a> Walk<'a> {
             return;
         }
         let [p, q, r] = self.a.mesh.mesh.triangle(t as usize);
-        self.sample((p + q + r) / 3.0);
+        self.deepest.sample((p + q + r) / 3.0);
         for v in self.a.mesh.mesh.triangles[t as usize] {
             self.vertex(v);
         }
@@ -457,18 +442,42 @@ impl<'a> Walk<'a> {
         if std::mem::replace(&mut self.seen_vertex[v as usize], true) {
             return;
         }
-        if self.sample(self.a.mesh.mesh.vertices[v as usize]) {
+        if self.deepest.sample(self.a.mesh.mesh.vertices[v as usize]) {
             self.inside.push(v);
         }
     }
+}
 
-    /// Whether the point of a (local frame) lies inside b; the deepest so far is kept.
+/// The deepest of the sample points of one mesh (its local frame) that lie inside another, b.
+struct Deepest<'a> {
+    b: MeshRef<'a>,
+    a_in_b: Pose,
+    pose_b: Pose,
+    b_box: Aabb,
+    /// Depth, deepest point (b's frame) and its nearest point on b's surface (b's frame).
+    best: (f32, Vec3, Vec3),
+}
+
+impl<'a> Deepest<'a> {
+    fn new(pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
+        let to_b = pose_b.inverse();
+        let origin = to_b.transform_point(pose_a.translation);
+        Self {
+            b,
+            a_in_b: to_b.mul(pose_a),
+            pose_b: *pose_b,
+            b_box: b.bvh.root_aabb(),
+            best: (0.0, origin, origin),
+        }
+    }
+
+    /// Whether the point (the first mesh's frame) lies inside b; the deepest so far is kept.
     fn sample(&mut self, local: Vec3) -> bool {
         let p = self.a_in_b.transform_point(local);
         if self.b_box.distance_squared_to_point(p) > 0.0 {
             return false;
         }
-        // The sample is near b's surface: a ray away from b's middle leaves it at once.
+        // Samples inside lie near b's surface: a ray away from b's middle leaves it at once.
         let out = (p - self.b_box.centre()).normalize_or_zero();
         let first = (out.abs().min_element() > 1e-3).then_some(out);
         if !point_inside_mesh_along(self.b, p, first) {
@@ -481,30 +490,31 @@ impl<'a> Walk<'a> {
         }
         true
     }
+
+    /// Depth, point (world) and nearest point of b's surface (world); depth 0 and the first
+    /// mesh's origin when no sample lay inside.
+    fn result(self) -> (f32, Vec3, Vec3) {
+        let (d, p, q) = self.best;
+        (
+            d,
+            self.pose_b.transform_point(p),
+            self.pose_b.transform_point(q),
+        )
+    }
 }
 
 /// The deepest sample point of `a` (vertices and triangle centroids) inside `b`: its depth, the point
 /// (world) and the nearest point of b's surface (world).
 fn deepest_point(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, Vec3, Vec3) {
-    let a_in_b = pose_b.inverse().mul(pose_a);
-    let b_box = b.bvh.root_aabb();
+    let mut deepest = Deepest::new(pose_a, b, pose_b);
     let centroids = (0..a.mesh.triangles.len()).map(|i| {
         let [p, q, r] = a.mesh.triangle(i);
         (p + q + r) / 3.0
     });
-    let mut best = (0.0f32, pose_a.translation, pose_a.translation);
     for local in a.mesh.vertices.iter().copied().chain(centroids) {
-        let p = a_in_b.transform_point(local);
-        if b_box.distance_squared_to_point(p) > 0.0 || !point_inside_mesh(b, p) {
-            continue;
-        }
-        if let Some((q, d)) = closest_point_on_mesh(b, p)
-            && d > best.0
-        {
-            best = (d, pose_b.transform_point(p), pose_b.transform_point(q));
-        }
+        deepest.sample(local);
     }
-    best
+    deepest.result()
 }
 
 #[cfg(test)]
@@ -649,30 +659,27 @@ mod tests {
         let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
         let (small, small_bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
         let (big_stars, small_stars) = (VertexStars::of(&big), VertexStars::of(&small));
-        let side = |mesh, bvh, stars| NearContact {
-            mesh: MeshRef { mesh, bvh },
+        let big_ref = MeshRef {
+            mesh: &big,
+            bvh: &big_bvh,
+        };
+        let small_ref = MeshRef {
+            mesh: &small,
+            bvh: &small_bvh,
+        };
+        let side = |mesh, stars| NearContact {
+            mesh,
             stars,
             near: &[],
         };
         let pose = Pose::new(Quat::from_rotation_y(0.3), Vec3::ZERO);
         let walked = mesh_penetration_near(
-            side(&big, &big_bvh, &big_stars),
+            side(big_ref, &big_stars),
             &Pose::IDENTITY,
-            side(&small, &small_bvh, &small_stars),
+            side(small_ref, &small_stars),
             &pose,
         );
-        let whole = mesh_penetration(
-            MeshRef {
-                mesh: &big,
-                bvh: &big_bvh,
-            },
-            &Pose::IDENTITY,
-            MeshRef {
-                mesh: &small,
-                bvh: &small_bvh,
-            },
-            &pose,
-        );
+        let whole = mesh_penetration(big_ref, &Pose::IDENTITY, small_ref, &pose);
         assert!(walked.0 > 3.5, "{walked:?}");
         assert_eq!(walked, whole);
     }
