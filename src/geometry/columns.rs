@@ -275,6 +275,17 @@ impl Columns {
                     continue;
                 }
                 let line = self.line(i, j);
+                // A line whose chord through the largest sphere lies inside the solid adds
+                // nothing for any radius.
+                if let Some(line) = line {
+                    let h = (r_max * r_max - d2).sqrt();
+                    let (a, b) = (ca - h, ca + h);
+                    if (self.lo0[line] <= a && self.hi0[line] >= b)
+                        || (self.lo1[line] <= a && self.hi1[line] >= b)
+                    {
+                        continue;
+                    }
+                }
                 for (half, acc) in row.iter_mut().enumerate().take(halves) {
                     let h = (r2[half] - f32x8::splat(d2)).max(f32x8::ZERO).sqrt();
                     let (a, b) = (ca8 - h, ca8 + h);
@@ -444,6 +455,142 @@ impl Columns {
     }
 }
 
+/// The lattice lines within some reach of one place, gathered by [`Columns::gather`] so that
+/// eight nearby spheres are measured at once, one per lane, in one pass over them. Coordinates are
+/// kept relative to the place, in the order (lattice u, lattice v, axis).
+#[derive(Clone, Debug, Default)]
+pub struct LocalLines {
+    anchor: [f32; 3],
+    reach: f32,
+    u: Vec<f32>,
+    v: Vec<f32>,
+    lo0: Vec<f32>,
+    hi0: Vec<f32>,
+    lo1: Vec<f32>,
+    hi1: Vec<f32>,
+    /// Lines with more than two intervals: (gathered index, lattice line).
+    more: Vec<(u32, u32)>,
+    cell2: f64,
+}
+
+impl Columns {
+    /// Gathers what measures any sphere inside the ball of radius `reach` around `centre` (see
+    /// [`LocalLines::holds`]): every lattice line (on the lattice or off it) that crosses the ball,
+    /// except those whose chord through the ball lies inside the solid, which no such sphere's
+    /// chord leaves.
+    pub fn gather(&self, centre: Vec3, reach: f32, out: &mut LocalLines) {
+        let (u, v) = ((self.axis + 1) % 3, (self.axis + 2) % 3);
+        let (cu, cv) = (centre[u] as f64, centre[v] as f64);
+        out.anchor = [centre[u], centre[v], centre[self.axis]];
+        out.reach = reach;
+        out.cell2 = (self.cell as f64).powi(2);
+        for list in [
+            &mut out.u,
+            &mut out.v,
+            &mut out.lo0,
+            &mut out.hi0,
+            &mut out.lo1,
+            &mut out.hi1,
+        ] {
+            list.clear();
+        }
+        out.more.clear();
+        let (i0, i1) = self.index_range(cu, reach, 0);
+        let (j0, j1) = self.index_range(cv, reach, 1);
+        let ca = centre[self.axis];
+        for i in i0..=i1 {
+            for j in j0..=j1 {
+                let x = self.line_centre(i, j);
+                let (du, dv) = ((x[0] - cu) as f32, (x[1] - cv) as f32);
+                let h2 = reach * reach - du * du - dv * dv;
+                if h2 <= 0.0 {
+                    continue;
+                }
+                let h = h2.sqrt();
+                if let Some(line) = self.line(i, j)
+                    && self
+                        .spans_of(line)
+                        .iter()
+                        .any(|s| s[0] <= ca - h && s[1] >= ca + h)
+                {
+                    continue;
+                }
+                let k = out.u.len() as u32;
+                out.u.push(du);
+                out.v.push(dv);
+                let (mut first, mut second) = (
+                    [f32::INFINITY, f32::NEG_INFINITY],
+                    [f32::INFINITY, f32::NEG_INFINITY],
+                );
+                if let Some(line) = self.line(i, j) {
+                    first = [self.lo0[line] - ca, self.hi0[line] - ca];
+                    second = [self.lo1[line] - ca, self.hi1[line] - ca];
+                    if self.more[line] {
+                        out.more.push((k, line as u32));
+                    }
+                }
+                out.lo0.push(first[0]);
+                out.hi0.push(first[1]);
+                out.lo1.push(second[0]);
+                out.hi1.push(second[1]);
+            }
+        }
+    }
+}
+
+impl LocalLines {
+    /// True when `s` lies inside the gathered ball, so that [`LocalLines::outside_volumes`]
+    /// measures it as [`Columns::outside_volume`] does.
+    pub fn holds(&self, columns: &Columns, s: &Sphere) -> bool {
+        let (u, v, a) = ((columns.axis + 1) % 3, (columns.axis + 2) % 3, columns.axis);
+        let d = Vec3::new(
+            s.centre[u] - self.anchor[0],
+            s.centre[v] - self.anchor[1],
+            s.centre[a] - self.anchor[2],
+        );
+        d.length() + s.radius <= self.reach
+    }
+
+    /// Volumes of eight spheres outside the solid (mm³), one per lane, by the rule of
+    /// [`Columns::outside_volume`] (to f32 rounding). Each sphere must pass
+    /// [`LocalLines::holds`]; a lane of radius 0 gives 0.
+    pub fn outside_volumes(&self, columns: &Columns, spheres: &[Sphere; 8]) -> [f64; 8] {
+        let (u, v, a) = ((columns.axis + 1) % 3, (columns.axis + 2) % 3, columns.axis);
+        let lane = |f: &dyn Fn(&Sphere) -> f32| f32x8::from(spheres.each_ref().map(f));
+        let cu = lane(&|s| s.centre[u] - self.anchor[0]);
+        let cv = lane(&|s| s.centre[v] - self.anchor[1]);
+        let ca = lane(&|s| s.centre[a] - self.anchor[2]);
+        let r2 = lane(&|s| s.radius * s.radius);
+        let mut acc = f32x8::ZERO;
+        for k in 0..self.u.len() {
+            let (du, dv) = (f32x8::splat(self.u[k]) - cu, f32x8::splat(self.v[k]) - cv);
+            let h = (r2 - du * du - dv * dv).max(f32x8::ZERO).sqrt();
+            let (lo, hi) = (ca - h, ca + h);
+            let inside = (f32x8::splat(self.hi0[k]).min(hi) - f32x8::splat(self.lo0[k]).max(lo))
+                .max(f32x8::ZERO)
+                + (f32x8::splat(self.hi1[k]).min(hi) - f32x8::splat(self.lo1[k]).max(lo))
+                    .max(f32x8::ZERO);
+            acc += (h + h - inside).max(f32x8::ZERO);
+        }
+        let mut out = acc.to_array().map(|x| x as f64);
+        for &(k, line) in &self.more {
+            let k = k as usize;
+            for (lane, s) in spheres.iter().enumerate() {
+                let (du, dv) = (
+                    self.u[k] - (s.centre[u] - self.anchor[0]),
+                    self.v[k] - (s.centre[v] - self.anchor[1]),
+                );
+                let h2 = s.radius * s.radius - du * du - dv * dv;
+                if h2 > 0.0 {
+                    let (h, c) = (h2.sqrt(), s.centre[a]);
+                    out[lane] -= columns.more_inside(line as usize, c - h, c + h) as f64;
+                }
+            }
+        }
+        out.map(|x| x.max(0.0) * self.cell2)
+    }
+}
+
 /// Total length of the intervals within [lo, hi].
 fn clipped_length(spans: &[[f32; 2]], lo: f32, hi: f32) -> f32 {
     spans
@@ -527,10 +674,8 @@ mod tests {
         assert!(out[1] > 0.0 && out[2] > out[1] && out[3] > out[2]);
     }
 
-    /// Three slabs stacked along the lines' axis: every line through them has three intervals,
-    /// and spheres that reach past the lattice meet lines with none.
-    #[test]
-    fn lines_with_many_intervals_and_spheres_off_the_lattice() {
+    /// Three 2 × 2 × 1 slabs stacked along z with gaps of 1.
+    fn three_slabs() -> TriMesh {
         let slab = |z0: f32| cuboid(Vec3::new(0.0, 0.0, z0), Vec3::new(2.0, 2.0, z0 + 1.0));
         let (a, b, d) = (slab(0.0), slab(2.0), slab(4.0));
         let mut vertices = a.vertices.clone();
@@ -540,8 +685,59 @@ mod tests {
             vertices.extend(&m.vertices);
             triangles.extend(m.triangles.iter().map(|t| t.map(|i| i + base)));
         }
-        let mesh = TriMesh::new(vertices, triangles);
-        let c = Columns::build(&mesh, 40);
+        TriMesh::new(vertices, triangles)
+    }
+
+    /// Eight spheres measured at once on gathered lines agree with one at a time, on lines with
+    /// three intervals, with none (off the lattice) and with partial ones; a sphere that pokes
+    /// out of the reach is reported as not held.
+    #[test]
+    fn gathered_lines_measure_eight_spheres_as_one_at_a_time() {
+        let c = Columns::build(&three_slabs(), 40);
+        let mut rng = crate::geometry::test_numbers(11);
+        let mut local = LocalLines::default();
+        for round in 0..40 {
+            let anchor = Vec3::new(rng() * 4.0 + 1.0, rng() * 4.0 + 1.0, rng() * 7.0 + 2.5);
+            let reach = 0.4 + (rng() + 0.5) * 1.6;
+            c.gather(anchor, reach, &mut local);
+            let spheres: [Sphere; 8] = std::array::from_fn(|k| {
+                let r = (0.3 + 0.7 * (rng() + 0.5)) * reach * 0.5;
+                let room = reach - r;
+                let offset = Vec3::new(rng(), rng(), rng() * 4.0) * room;
+                let offset = offset.clamp_length_max(room * 0.999);
+                let mut s = Sphere::new(anchor + offset, r);
+                if k == 7 && round % 2 == 0 {
+                    s.radius = 0.0;
+                }
+                s
+            });
+            let many = local.outside_volumes(&c, &spheres);
+            for (s, got) in spheres.iter().zip(many) {
+                if s.radius == 0.0 {
+                    assert_eq!(got, 0.0);
+                    continue;
+                }
+                assert!(local.holds(&c, s));
+                let one = c.outside_volume(s);
+                assert!(
+                    (one - got).abs() < 1e-4 * s.volume(),
+                    "round {round}: {got} vs {one} for {s:?}"
+                );
+            }
+            let out = Sphere::new(anchor + Vec3::new(reach * 0.7, 0.0, 0.0), reach * 0.5);
+            assert!(!local.holds(&c, &out));
+        }
+        assert!(
+            c.more.iter().filter(|&&m| m).count() > 100,
+            "the slabs give lines with three intervals"
+        );
+    }
+
+    /// Three slabs stacked along the lines' axis: every line through them has three intervals,
+    /// and spheres that reach past the lattice meet lines with none.
+    #[test]
+    fn lines_with_many_intervals_and_spheres_off_the_lattice() {
+        let c = Columns::build(&three_slabs(), 40);
         assert_eq!(c.axis, 2);
         assert!(c.more.iter().filter(|&&m| m).count() > 100);
         assert!((c.volume() - 12.0).abs() < 1e-3, "{}", c.volume());

@@ -24,7 +24,7 @@ pub use closest::{
     closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,
     triangle_plane_gap, triangles_intersect,
 };
-pub use columns::Columns;
+pub use columns::{Columns, LocalLines};
 pub use mass::MassProperties;
 pub use mesh_distance::{
     MeshRef, MeshSeparation, NearContact, mesh_penetration, mesh_penetration_near, mesh_separation,

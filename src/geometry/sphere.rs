@@ -35,48 +35,50 @@ impl Sphere {
         4.0 / 3.0 * std::f64::consts::PI * (self.radius as f64).powi(3)
     }
 
-    /// The smallest sphere containing every point (Welzl's algorithm in its iterative form, in f64,
-    /// over a deterministic shuffle), then grown to the largest f32 distance from the centre so that
-    /// every point passes [`Sphere::contains`]. Exact up to rounding; empty input gives a zero sphere
-    /// at the origin.
+    /// The smallest sphere containing every point, then grown to the largest f32 distance from
+    /// the centre so that every point passes [`Sphere::contains`]. Exact up to rounding; empty
+    /// input gives a zero sphere at the origin.
+    ///
+    /// Small sets go to Welzl's algorithm directly. Larger ones keep a core set, starting with the
+    /// extreme points along the axes: the smallest sphere around the core set is computed, the
+    /// point farthest outside it joins the set, until no point is outside. A sphere around a
+    /// subset that holds every point is the smallest for all of them, so the answer is the same,
+    /// from a few passes over the points instead of Welzl's shuffled recursion over all of them.
     pub fn enclosing(points: &[Vec3]) -> Sphere {
+        const DIRECT: usize = 128;
         if points.is_empty() {
             return Sphere::new(Vec3::ZERO, 0.0);
         }
-        let mut p: Vec<DVec3> = points.iter().map(|v| v.as_dvec3()).collect();
-        // Deterministic shuffle: the expected linear time needs a random order.
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        for i in (1..p.len()).rev() {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            p.swap(i, (state % (i as u64 + 1)) as usize);
-        }
-        let inside = |s: &(DVec3, f64), q: DVec3| q.distance(s.0) <= s.1 * (1.0 + 1e-12) + 1e-12;
-        let mut s = (p[0], 0.0);
-        for i in 1..p.len() {
-            if inside(&s, p[i]) {
-                continue;
-            }
-            s = (p[i], 0.0);
-            for j in 0..i {
-                if inside(&s, p[j]) {
-                    continue;
-                }
-                s = sphere2(p[i], p[j]);
-                for k in 0..j {
-                    if inside(&s, p[k]) {
-                        continue;
-                    }
-                    s = sphere3(p[i], p[j], p[k]);
-                    for l in 0..k {
-                        if !inside(&s, p[l]) {
-                            s = sphere4(p[i], p[j], p[k], p[l]);
-                        }
+        let s = if points.len() <= DIRECT {
+            welzl(points.iter().map(|v| v.as_dvec3()).collect())
+        } else {
+            let mut core: Vec<DVec3> = Vec::new();
+            for axis in 0..3 {
+                let by = |a: &&Vec3, b: &&Vec3| a[axis].total_cmp(&b[axis]);
+                for q in [points.iter().min_by(by), points.iter().max_by(by)]
+                    .into_iter()
+                    .flatten()
+                {
+                    if !core.contains(&q.as_dvec3()) {
+                        core.push(q.as_dvec3());
                     }
                 }
             }
-        }
+            loop {
+                let s = welzl(core.clone());
+                // Outside by more than rounding (a point of the core set never is).
+                let limit = (s.1 * (1.0 + 1e-9) + 1e-9).powi(2);
+                let far = points
+                    .iter()
+                    .map(|q| (q.as_dvec3().distance_squared(s.0), q))
+                    .filter(|(d2, _)| *d2 > limit)
+                    .max_by(|a, b| a.0.total_cmp(&b.0));
+                match far {
+                    Some((_, q)) if !core.contains(&q.as_dvec3()) => core.push(q.as_dvec3()),
+                    _ => break s,
+                }
+            }
+        };
         let centre = s.0.as_vec3();
         let radius = points
             .iter()
@@ -85,6 +87,45 @@ impl Sphere {
         // One ulp more so that the squared comparison in `contains` holds for every point.
         Sphere::new(centre, radius.next_up())
     }
+}
+
+/// Welzl's algorithm in its iterative form, in f64, over a deterministic shuffle: the smallest
+/// sphere (centre, radius) around non-empty `p`.
+fn welzl(mut p: Vec<DVec3>) -> (DVec3, f64) {
+    // Deterministic shuffle: the expected linear time needs a random order.
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    for i in (1..p.len()).rev() {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        p.swap(i, (state % (i as u64 + 1)) as usize);
+    }
+    let inside = |s: &(DVec3, f64), q: DVec3| q.distance(s.0) <= s.1 * (1.0 + 1e-12) + 1e-12;
+    let mut s = (p[0], 0.0);
+    for i in 1..p.len() {
+        if inside(&s, p[i]) {
+            continue;
+        }
+        s = (p[i], 0.0);
+        for j in 0..i {
+            if inside(&s, p[j]) {
+                continue;
+            }
+            s = sphere2(p[i], p[j]);
+            for k in 0..j {
+                if inside(&s, p[k]) {
+                    continue;
+                }
+                s = sphere3(p[i], p[j], p[k]);
+                for l in 0..k {
+                    if !inside(&s, p[l]) {
+                        s = sphere4(p[i], p[j], p[k], p[l]);
+                    }
+                }
+            }
+        }
+    }
+    s
 }
 
 /// `n` unit directions spread evenly over the sphere (a Fibonacci lattice), deterministic.
@@ -197,6 +238,33 @@ mod tests {
             assert!(
                 s.radius <= 0.5 * b.extent().length() + 1e-4,
                 "n = {n}: {s:?}"
+            );
+        }
+    }
+
+    /// Large sets go through the core set; the sphere is the one Welzl's algorithm finds over
+    /// all the points, for blobs, shells (where every point is nearly extreme) and flat patches.
+    #[test]
+    fn core_set_spheres_match_welzl_over_every_point() {
+        let mut rnd = crate::geometry::test_numbers(3);
+        for (n, shape) in [(500usize, 0), (3000, 1), (3000, 2), (20_000, 1)] {
+            let pts: Vec<Vec3> = (0..n)
+                .map(|_| {
+                    let p = Vec3::new(rnd(), rnd(), rnd());
+                    match shape {
+                        0 => p * Vec3::new(4.0, 1.0, 2.0),
+                        1 => p.normalize_or_zero() * 3.0 + Vec3::X,
+                        _ => Vec3::new(p.x * 5.0, p.y * 2.0, 0.3 * p.z * p.z),
+                    }
+                })
+                .collect();
+            let s = Sphere::enclosing(&pts);
+            let w = welzl(pts.iter().map(|v| v.as_dvec3()).collect());
+            assert!(pts.iter().all(|p| s.contains(*p)), "n {n} shape {shape}");
+            assert!(
+                (s.radius as f64 - w.1).abs() < 1e-5 * w.1
+                    && s.centre.as_dvec3().distance(w.0) < 1e-4 * w.1,
+                "n {n} shape {shape}: {s:?} vs {w:?}"
             );
         }
     }

@@ -6,36 +6,43 @@
 //!    its pieces are shorter than 0.3 s, where s = √(area / leaf budget) is the leaf spacing.
 //! 2. **Medial centres.** For 6 seeds per leaf of the budget, spread evenly by area, the maximal
 //!    inscribed ball tangent at the seed, by the shrinking-ball method (Ma, Bae, Choi and Lee
-//!    2012). Its centre lies on the medial axis; a sphere there, slightly larger than the ball,
-//!    bulges out of the tooth only as a flat cap around the tangent points, which is what makes
-//!    medial spheres tight.
+//!    2012), starting from half the distance to the surface straight inwards (an upper bound on
+//!    the radius). Its centre lies on the medial axis; a sphere there, slightly larger than the
+//!    ball, bulges out of the tooth only as a flat cap around the tangent points, which is what
+//!    makes medial spheres tight.
 //! 3. **Candidates.** Each medial ball grown by a geometric series of margins (fractions of s). A
 //!    candidate covers the pieces whose three corners it holds and is shrunk to the farthest of
 //!    them; its cost is its volume outside the tooth, by exact line integrals over a lattice
-//!    ([`Columns`], all margins of a ball in one pass over the lines). A tiny sphere around each
-//!    piece no candidate covers, and the smallest sphere around the whole mesh, keep the cover
-//!    always feasible.
+//!    ([`Columns`], all margins of a ball in one pass over the lines, skipping lines whose chord
+//!    through the largest margin lies inside the tooth). A tiny sphere around each piece no
+//!    candidate covers, and the smallest sphere around the whole mesh, keep the cover always
+//!    feasible.
 //! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ)),
-//!    evaluated lazily: gains only fall as pieces are covered, so a heap of stale gains is an upper
-//!    bound and only its top is re-measured. Then spheres whose pieces others cover are dropped. The
-//!    sum of the costs is the paper's `sov_sum` (times the tooth volume) plus λ per leaf; λ is
-//!    searched (from a guess scaled from the λ = 0 cover, then on log λ against log size) so that
-//!    the cover just fits 8 % over the budget B^(levels−1): polishing leaves a few spheres with no
-//!    surface of their own, and step 6 drops any leaves still over the budget.
+//!    evaluated lazily over exact integer gains that are kept current as pieces are covered
+//!    ([`GainIndex`]: a ball's margins share increments, each piece lists the increments that
+//!    hold it). Then spheres whose pieces others cover are dropped. The sum of the costs is the
+//!    paper's `sov_sum` (times the tooth volume) plus λ per leaf; λ is searched (from a guess
+//!    scaled from the λ = 0 cover, then on log λ against log size) so that the cover just fits 8 %
+//!    over the budget B^(levels−1): polishing leaves a few spheres with no surface of their own,
+//!    and step 6 drops any leaves still over the budget.
 //! 5. **Shrink and polish.** The cover is decided on pieces; the spheres are then tightened on a
-//!    lattice of 15 points per piece: each point goes to the sphere that holds it with the most
+//!    lattice of 10 points per piece: each point goes to the sphere that holds it with the most
 //!    room, each sphere shrinks to its points (radii only shrink, so the points stay covered), and
 //!    each sphere's centre is moved by a pattern search that lowers its outside volume while it
-//!    holds its points (the farthest point found over lanes of eight). A piece whose three corners
-//!    go to one sphere goes to it whole, without testing its inner points: the sphere holds its
-//!    corners, so the whole piece, whose farthest point from the centre is a corner. One shrinking
-//!    round, then five rounds of polish and shrink; after the first, a sphere's search starts
-//!    at twice the largest step that moved it the round before.
-//! 6. **Exact cover.** Every triangle is split as the coverage check splits it until each piece
-//!    lies in one sphere (the one with the most room); a piece no sphere holds after five splits —
+//!    holds its points: eight trial centres at a time, their farthest points in one pass over the
+//!    points and their outside volumes in one pass over the lattice lines gathered around the
+//!    sphere ([`LocalLines`], without the lines whose chord stays inside the tooth). Piece corners
+//!    are numbered once, so a corner shared by six pieces is placed once. A piece whose three
+//!    corners go to one sphere goes to it whole, without testing its inner points: the sphere
+//!    holds its corners, so the whole piece, whose farthest point from the centre is a corner. One
+//!    shrinking round, then five rounds of polish and shrink; after the first, a sphere's search
+//!    starts at twice the longest move it made the round before.
+//! 6. **Exact cover.** Spheres that hold no points go; if more than the budget hold some, those
+//!    holding the fewest pieces go too. A piece that the lattice gave wholly to a kept sphere goes
+//!    to it; every other triangle piece is split as the coverage check splits it until each part
+//!    lies in one sphere (the one with the most room); a part no sphere holds after five splits —
 //!    a sliver between the points — grows the sphere that needs the least growth. Each sphere then
-//!    shrinks to the pieces it is responsible for. If more leaves than the budget hold pieces, the
-//!    ones holding the fewest go and the exact cover is made again without them.
+//!    shrinks to the pieces it is responsible for.
 //! 7. **Hierarchy.** Leaves are split into B balanced groups along the longest axis of their
 //!    centres, recursively; each inner sphere is the smallest sphere around the pieces its leaves
 //!    are responsible for, so invariant (2) holds by construction.
@@ -46,7 +53,7 @@
 //! Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
-//! 0.074 (0.057–0.094), about 510 leaves; see the README for the table and the build times.
+//! 0.074 (0.057–0.096), about 508 leaves; see the README for the table and the build times.
 
 use std::{cmp::Ordering, collections::BinaryHeap};
 
@@ -58,7 +65,8 @@ use super::{
     tree::{SphereTree, triangles_touching},
 };
 use crate::geometry::{
-    Columns, MeshRef, Sphere, TriMesh, TriangleBvh, mesh_distance::closest_point_on_mesh,
+    Columns, LocalLines, MeshRef, Sphere, TriMesh, TriangleBvh,
+    mesh_distance::{closest_point_on_mesh, ray_first_hit},
 };
 
 /// Growth margins of the candidates, as fractions of the leaf spacing s.
@@ -80,11 +88,16 @@ const SEEDS_PER_LEAF: usize = 6;
 /// Most medial seeds.
 const MAX_SEEDS: usize = 6_000;
 /// Points per piece edge (minus one) for the shrinking rounds: a 4 × 4 lattice of points per piece.
-const POINT_LATTICE: u32 = 4;
+const POINT_LATTICE: u32 = 3;
 /// Shrinking rounds after the cover.
 const SHRINK_ROUNDS: u32 = 1;
 /// Rounds of centre polishing, each followed by a shrinking round.
 const POLISH_ROUNDS: u32 = 5;
+/// Most batches of eight trial centres per sphere and polishing round.
+const POLISH_BATCHES: u32 = 10;
+/// The lattice lines gathered for a polish reach this much past the first batch's spheres, so
+/// that the next few moves are measured without gathering again.
+const REACH: f32 = 1.1;
 /// Lattice lines across the tooth for outside volumes while polishing.
 const LINES: usize = 64;
 /// The same for the candidates' costs, which only rank candidates against each other.
@@ -100,9 +113,12 @@ const LEAST_FIRST_STEP: f32 = 0.04;
 const MARGIN_REL: f32 = 1e-6;
 const MARGIN_ABS: f32 = 1e-5;
 
-/// Surface pieces (corners, centroid, face normal, area).
+/// Surface pieces (corners, centroid, face normal, area), and their corners numbered once:
+/// pieces that share a corner (bit for bit, as `split4` gives neighbours) share its number.
 struct Pieces {
     corners: Vec<[Vec3; 3]>,
+    corner_id: Vec<[u32; 3]>,
+    corner_at: Vec<Vec3>,
     centroid: Vec<Vec3>,
     normal: Vec<Vec3>,
     area: Vec<f32>,
@@ -135,10 +151,13 @@ fn split_surface(mesh: &TriMesh, edge: f32) -> Pieces {
     }
     let mut p = Pieces {
         corners: Vec::new(),
+        corner_id: Vec::new(),
+        corner_at: Vec::new(),
         centroid: Vec::new(),
         normal: Vec::new(),
         area: Vec::new(),
     };
+    let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
     for (t, &level) in lv.iter().enumerate() {
         let tri = mesh.triangle(t);
         let normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]).normalize_or_zero();
@@ -149,6 +168,14 @@ fn split_surface(mesh: &TriMesh, edge: f32) -> Pieces {
                 continue;
             }
             p.corners.push(piece);
+            p.corner_id.push(piece.map(|q| {
+                let next = ids.len() as u32;
+                *ids.entry(q.to_array().map(f32::to_bits))
+                    .or_insert_with(|| {
+                        p.corner_at.push(q);
+                        next
+                    })
+            }));
             p.centroid.push((piece[0] + piece[1] + piece[2]) / 3.0);
             p.normal.push(normal);
             p.area
@@ -158,9 +185,13 @@ fn split_surface(mesh: &TriMesh, edge: f32) -> Pieces {
     p
 }
 
-/// The maximal inscribed ball tangent at `p` (outward normal `n`), by shrinking.
+/// The maximal inscribed ball tangent at `p` (outward normal `n`), by shrinking from `start`, or
+/// from half the distance to the surface straight inwards, if that is less: the ball's diameter
+/// along −n runs inside the mesh, so it is an upper bound, and the first ball is then nearly
+/// tight.
 fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
-    let mut r = start;
+    let t_min = 1e-4 * start;
+    let mut r = ray_first_hit(mesh, p, -n, t_min).map_or(start, |t| (0.5 * t).min(start));
     for _ in 0..40 {
         let c = p - n * r;
         let Some((q, d)) = closest_point_on_mesh(mesh, c) else {
@@ -259,10 +290,28 @@ impl PieceGrid {
         let centre = [c.x, c.y, c.z].map(f32x8::splat);
         let lane = f32x8::from(std::array::from_fn::<f32, 8, _>(|k| k as f32));
         let load = |v: &[f32], j: usize| f32x8::from(<[f32; 8]>::try_from(&v[j..j + 8]).unwrap());
+        // The distance from the centre to a run of cells along one axis, off the run's axis.
+        let gap = |i: usize, axis: usize| {
+            let lo = self.min[axis] + i as f32 * self.cell;
+            (lo - c[axis]).max(c[axis] - lo - self.cell).max(0.0)
+        };
         for x in clamp(lo.x, self.dims[0])..=clamp(hi.x, self.dims[0]) {
             for y in clamp(lo.y, self.dims[1])..=clamp(hi.y, self.dims[1]) {
+                // Only the cells along z that the ball reaches (centroids lie within r).
+                let room = r * r - gap(x, 0).powi(2) - gap(y, 1).powi(2);
+                if room < 0.0 {
+                    continue;
+                }
+                let half = room.sqrt();
+                let (zl, zh) = (
+                    ((c.z - half - self.min.z) / self.cell).floor(),
+                    ((c.z + half - self.min.z) / self.cell).floor(),
+                );
+                if zh < 0.0 {
+                    continue;
+                }
                 let row = (x * self.dims[1] + y) * self.dims[2];
-                let (z0, z1) = (clamp(lo.z, self.dims[2]), clamp(hi.z, self.dims[2]));
+                let (z0, z1) = (clamp(zl, self.dims[2]), clamp(zh, self.dims[2]));
                 // Cells along z are consecutive in `items`.
                 let (a, b) = (
                     self.start[row + z0] as usize,
@@ -374,8 +423,6 @@ fn candidates(
             if bucket.is_empty() {
                 continue;
             }
-            // In index order, so that the cover reads the pieces' state in memory order.
-            bucket.sort_unstable();
             out.pool.extend_from_slice(bucket);
             reach_so_far = reach_so_far.max(far[b].sqrt());
             prefixes.push(out.pool.len() - first as usize);
@@ -437,51 +484,127 @@ impl Ord for Entry {
     }
 }
 
-/// A piece's weight in the cover: its area, and a little for a degenerate piece so that it still
-/// counts as something to cover.
-fn piece_weight(area: f32) -> f32 {
-    area.max(f32::MIN_POSITIVE)
+/// What the greedy cover keeps current: each candidate's gain as a sum of increments.
+///
+/// The candidates of one medial ball cover nested prefixes of one run of the pool, so candidate k
+/// of a group covers the increments of the group's candidates up to k. Pieces weigh their area in
+/// whole units (2⁻⁴⁰ of the tooth's area, at least one), so that gains are exact integers: when a
+/// piece is covered its weight leaves every increment that holds it, and a gain is zero exactly
+/// when all its pieces are covered.
+struct GainIndex {
+    /// Per candidate: the first candidate of its group.
+    group_start: Vec<u32>,
+    /// Per candidate: the weight of the pieces its increment adds to the group's previous one.
+    increment: Vec<u64>,
+    /// Per piece: its weight.
+    weight: Vec<u64>,
+    /// Per piece: the candidates whose increment holds it (`owners[start[i]..start[i + 1]]`).
+    start: Vec<u32>,
+    owners: Vec<u32>,
+}
+
+impl GainIndex {
+    fn new(c: &Candidates, area: &[f32]) -> Self {
+        let total: f64 = area.iter().map(|&a| a.max(0.0) as f64).sum();
+        let unit = if total > 0.0 {
+            2f64.powi(40) / total
+        } else {
+            1.0
+        };
+        let weight: Vec<u64> = area
+            .iter()
+            .map(|&a| ((a.max(0.0) as f64 * unit).round() as u64).max(1))
+            .collect();
+        let mut group_start = Vec::with_capacity(c.list.len());
+        let mut increment = Vec::with_capacity(c.list.len());
+        let mut count = vec![0u32; area.len() + 1];
+        let mut runs = Vec::with_capacity(c.list.len());
+        for (k, x) in c.list.iter().enumerate() {
+            let (g, from) = match k.checked_sub(1).map(|j| (j, &c.list[j])) {
+                Some((j, prev)) if prev.first == x.first && prev.len <= x.len => {
+                    (group_start[j], prev.len)
+                }
+                _ => (k as u32, 0),
+            };
+            group_start.push(g);
+            let run = x.first as usize + from as usize..(x.first + x.len) as usize;
+            increment.push(
+                c.pool[run.clone()]
+                    .iter()
+                    .map(|&i| weight[i as usize])
+                    .sum(),
+            );
+            for &i in &c.pool[run.clone()] {
+                count[i as usize + 1] += 1;
+            }
+            runs.push(run);
+        }
+        for i in 1..count.len() {
+            count[i] += count[i - 1];
+        }
+        let mut fill = count.clone();
+        let mut owners = vec![0u32; count[area.len()] as usize];
+        for (k, run) in runs.into_iter().enumerate() {
+            for &i in &c.pool[run] {
+                owners[fill[i as usize] as usize] = k as u32;
+                fill[i as usize] += 1;
+            }
+        }
+        Self {
+            group_start,
+            increment,
+            weight,
+            start: count,
+            owners,
+        }
+    }
 }
 
 /// Greedy weighted set cover: repeatedly the candidate with the most newly covered area per
 /// (cost + λ), ties to the lower index; returns the chosen candidates in order.
 ///
-/// Lazy evaluation (Minoux's accelerated greedy): a candidate's gain only falls as pieces are
-/// covered, so the heap holds upper bounds; the top is re-measured, and taken when its true key
-/// still beats the next bound, which makes it the true best without updating every candidate that
-/// shares a newly covered piece.
-fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Vec<u32> {
-    let key = |k: usize, gain: f64| gain / (c.list[k].cost + lambda).max(1e-12);
-    let mut heap: BinaryHeap<Entry> = (0..c.list.len())
-        .filter(|&k| c.list[k].len > 0)
-        .map(|k| Entry(key(k, initial_gain[k]), k as u32))
-        .collect();
-    // The area each piece would still add (zero once covered), in f32 to halve the memory read.
-    let mut open: Vec<f32> = area.iter().map(|&a| piece_weight(a)).collect();
-    let mut uncovered = area.len();
-    let mut chosen = Vec::new();
-    let members = |k: usize| {
-        let x = &c.list[k];
-        &c.pool[x.first as usize..(x.first + x.len) as usize]
+/// Gains are kept exact as pieces are covered ([`GainIndex`]), and the heap is lazy (Minoux's
+/// accelerated greedy): a candidate's gain only falls, so a stored key is an upper bound; the top
+/// is re-keyed, and taken when its true key still beats the next bound, which makes it the true
+/// best without re-keying every candidate that shares a newly covered piece.
+fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32> {
+    let key = |k: usize, gain: u64| gain as f64 / (c.list[k].cost + lambda).max(1e-12);
+    let mut increment = index.increment.clone();
+    let gain = |increment: &[u64], k: usize| -> u64 {
+        increment[index.group_start[k] as usize..=k].iter().sum()
     };
+    let mut heap: BinaryHeap<Entry> = (0..c.list.len())
+        .filter_map(|k| {
+            let g = gain(&increment, k);
+            (g > 0).then(|| Entry(key(k, g), k as u32))
+        })
+        .collect();
+    let mut open = vec![true; index.weight.len()];
+    let mut uncovered = open.len();
+    let mut chosen = Vec::new();
     while uncovered > 0 {
         let Some(Entry(_, k)) = heap.pop() else {
             break;
         };
         let k = k as usize;
-        let gain = members(k).iter().map(|&i| open[i as usize]).sum::<f32>() as f64;
-        if gain == 0.0 {
+        let g = gain(&increment, k);
+        if g == 0 {
             continue;
         }
-        let entry = Entry(key(k, gain), k as u32);
+        let entry = Entry(key(k, g), k as u32);
         if heap.peek().is_some_and(|top| *top > entry) {
             heap.push(entry);
             continue;
         }
-        for &i in members(k) {
-            if open[i as usize] > 0.0 {
-                open[i as usize] = 0.0;
+        let x = &c.list[k];
+        for &i in &c.pool[x.first as usize..(x.first + x.len) as usize] {
+            let i = i as usize;
+            if open[i] {
+                open[i] = false;
                 uncovered -= 1;
+                for &j in &index.owners[index.start[i] as usize..index.start[i + 1] as usize] {
+                    increment[j as usize] -= index.weight[i];
+                }
             }
         }
         chosen.push(k as u32);
@@ -496,21 +619,9 @@ fn greedy(c: &Candidates, area: &[f32], initial_gain: &[f64], lambda: f64) -> Ve
 /// tightest bracket. It stops once a cover uses at least 97 % of the budget.
 fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
-    // Each candidate's area: the same for every run.
-    // Summed in f32 in member order, as the cover re-measures it: a float sum never grows when
-    // a term is replaced by zero, so these stay upper bounds.
-    let initial_gain: Vec<f64> = c
-        .list
-        .iter()
-        .map(|x| {
-            c.pool[x.first as usize..(x.first + x.len) as usize]
-                .iter()
-                .map(|&i| piece_weight(area[i as usize]))
-                .sum::<f32>() as f64
-        })
-        .collect();
+    let index = GainIndex::new(c, area);
     let run = |lambda: f64| {
-        let mut chosen = greedy(c, area, &initial_gain, lambda);
+        let mut chosen = greedy(c, &index, lambda);
         prune(c, &mut chosen, area.len());
         chosen
     };
@@ -664,63 +775,78 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
             owner[i as usize] = j as u32;
         }
     }
-    let (mut points, mut point_owner) = (Vec::new(), Vec::new());
-    let lattice = Lattice::new(POINT_LATTICE);
-    for (i, &corners) in pieces.corners.iter().enumerate() {
-        lattice.points_on(corners, &mut points);
-        point_owner.resize(points.len(), owner[i]);
-    }
-    shrink(
-        &mut spheres,
-        &points,
-        &mut point_owner,
-        lattice,
-        SHRINK_ROUNDS,
-        s,
-    );
+    let mut surface = Surface::new(&pieces, &owner, Lattice::new(POINT_LATTICE));
+    shrink(&mut spheres, &mut surface, SHRINK_ROUNDS, s);
     let mut steps = vec![FIRST_STEP; spheres.len()];
+    let mut mark = vec![u32::MAX; pieces.corner_at.len()];
     for _ in 0..POLISH_ROUNDS {
-        // A piece owned whole is represented by its corners (its farthest points from any centre).
+        mark.fill(u32::MAX);
+        // A piece owned whole is represented by its corners (its farthest points from any centre),
+        // each corner once per sphere as far as neighbouring pieces show it.
         let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
-        for (piece, own) in points
+        let lattice = surface.lattice;
+        for ((piece, own), ids) in surface
+            .points
             .chunks(lattice.len)
-            .zip(point_owner.chunks(lattice.len))
+            .zip(surface.owner.chunks(lattice.len))
+            .zip(&pieces.corner_id)
         {
             if own.iter().all(|&o| o == own[0]) {
-                owned[own[0] as usize].extend(lattice.corners.map(|k| piece[k]));
+                for id in ids {
+                    if mark[*id as usize] != own[0] {
+                        mark[*id as usize] = own[0];
+                        owned[own[0] as usize].push(pieces.corner_at[*id as usize]);
+                    }
+                }
             } else {
                 for (p, &o) in piece.iter().zip(own) {
                     owned[o as usize].push(*p);
                 }
             }
         }
+        let mut local = LocalLines::default();
         for ((sphere, points), step) in spheres.iter_mut().zip(&owned).zip(&mut steps) {
             if !points.is_empty() {
-                let (polished, moved) = polish(&columns, *sphere, points, *step);
+                let (polished, moved) = polish(&columns, &mut local, *sphere, points, *step);
                 *sphere = polished;
                 *step = (2.0 * moved / sphere.radius).clamp(LEAST_FIRST_STEP, FIRST_STEP);
             }
         }
-        shrink(&mut spheres, &points, &mut point_owner, lattice, 1, s);
+        shrink(&mut spheres, &mut surface, 1, s);
     }
-    let (mut leaves, mut corners) = cover_exact(spheres, &pieces.corners, s);
-    if leaves.len() > max_leaves {
-        // Over the budget: the leaves holding the fewest pieces go, and the others take their
-        // pieces over (growing where they must).
-        let mut order: Vec<usize> = (0..leaves.len()).collect();
-        order.sort_by_key(|&k| (corners[k].len(), k));
-        let mut keep = vec![true; leaves.len()];
-        for &k in &order[..leaves.len() - max_leaves] {
-            keep[k] = false;
+    // The spheres' shares of the surface: a piece wholly in one sphere is its hint for the
+    // exact cover. Spheres left with nothing go; if more than the budget hold something, those
+    // holding the fewest pieces go too, and the others take their pieces over.
+    let lattice = surface.lattice;
+    let mut hint = vec![u32::MAX; pieces.corners.len()];
+    let mut held = vec![0usize; spheres.len()];
+    for (i, own) in surface.owner.chunks(lattice.len).enumerate() {
+        if own.iter().all(|&o| o == own[0]) {
+            hint[i] = own[0];
+            held[own[0] as usize] += 1;
+        } else {
+            let mut seen: Vec<u32> = own.to_vec();
+            seen.sort_unstable();
+            seen.dedup();
+            seen.iter().for_each(|&o| held[o as usize] += 1);
         }
-        let kept: Vec<Sphere> = leaves
-            .iter()
-            .zip(&keep)
-            .filter(|(_, k)| **k)
-            .map(|(s, _)| *s)
-            .collect();
-        (leaves, corners) = cover_exact(kept, &pieces.corners, s);
     }
+    let mut order: Vec<usize> = (0..spheres.len()).filter(|&k| held[k] > 0).collect();
+    if order.len() > max_leaves {
+        order.sort_by_key(|&k| (std::cmp::Reverse(held[k]), k));
+        order.truncate(max_leaves);
+        order.sort_unstable();
+    }
+    let mut index = vec![u32::MAX; spheres.len()];
+    for (j, &k) in order.iter().enumerate() {
+        index[k] = j as u32;
+    }
+    let hint: Vec<u32> = hint
+        .iter()
+        .map(|&h| index.get(h as usize).copied().unwrap_or(u32::MAX))
+        .collect();
+    let kept: Vec<Sphere> = order.iter().map(|&k| spheres[k]).collect();
+    let (leaves, corners) = cover_exact(kept, &pieces, &hint, s);
     let order: Vec<usize> = (0..leaves.len()).collect();
     place(&mut tree, 0, 0, order, &leaves, &corners, mesh);
     tree
@@ -854,24 +980,52 @@ impl LaneGrid {
     }
 }
 
+/// The lattice points of every piece with the sphere each belongs to, and each numbered piece
+/// corner with its sphere.
+struct Surface<'a> {
+    pieces: &'a Pieces,
+    lattice: Lattice,
+    /// Runs of `lattice.len` points per piece, the piece's corners at `lattice.corners`.
+    points: Vec<Vec3>,
+    owner: Vec<u32>,
+    corner_owner: Vec<u32>,
+}
+
+impl<'a> Surface<'a> {
+    /// Every point starts with the sphere that covers its piece.
+    fn new(pieces: &'a Pieces, piece_owner: &[u32], lattice: Lattice) -> Self {
+        let (mut points, mut owner) = (Vec::new(), Vec::new());
+        let mut corner_owner = vec![0u32; pieces.corner_at.len()];
+        for (i, &corners) in pieces.corners.iter().enumerate() {
+            lattice.points_on(corners, &mut points);
+            owner.resize(points.len(), piece_owner[i]);
+            for id in pieces.corner_id[i] {
+                corner_owner[id as usize] = piece_owner[i];
+            }
+        }
+        Self {
+            pieces,
+            lattice,
+            points,
+            owner,
+            corner_owner,
+        }
+    }
+}
+
 /// Shrinks the spheres: each point goes to the sphere that holds it with the most room (least
 /// distance / radius, compared as squares) and every sphere shrinks to its own points, `rounds`
 /// times. Radii never grow, so every point stays inside the sphere it belongs to.
 ///
-/// Points come in runs of `lattice.len` per piece with the piece's corners at `lattice.corners`.
-/// A piece whose three corners go to one sphere goes to it whole: the sphere holds the corners, so
-/// (being convex) the whole piece, and its farthest point from the centre is a corner.
-fn shrink(
-    spheres: &mut [Sphere],
-    pts: &[Vec3],
-    owner: &mut [u32],
-    lattice: Lattice,
-    rounds: u32,
-    cell: f32,
-) {
+/// Each numbered piece corner is placed once. A piece whose three corners go to one sphere goes
+/// to it whole: the sphere holds the corners, so (being convex) the whole piece, and its farthest
+/// point from the centre is a corner.
+fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32) {
     let grid = SphereGrid::new(spheres, cell);
     let mut lanes = LaneGrid::new(&grid, spheres);
     let mut radius = vec![0.0f32; spheres.len()];
+    let mut corner_best = vec![(0u32, 0.0f32, 0.0f32); surface.corner_owner.len()];
+    let lattice = surface.lattice;
     for round in 0..rounds.max(1) {
         if round > 0 {
             lanes.update(spheres);
@@ -902,8 +1056,20 @@ fn shrink(
             }
             best
         };
-        for (piece, own) in pts.chunks(lattice.len).zip(owner.chunks_mut(lattice.len)) {
-            let corners = lattice.corners.map(|k| best_of(piece[k], own[k] as usize));
+        for ((best, &p), own) in corner_best
+            .iter_mut()
+            .zip(&surface.pieces.corner_at)
+            .zip(&surface.corner_owner)
+        {
+            *best = best_of(p, *own as usize);
+        }
+        for ((piece, own), ids) in surface
+            .points
+            .chunks(lattice.len)
+            .zip(surface.owner.chunks_mut(lattice.len))
+            .zip(&surface.pieces.corner_id)
+        {
+            let corners = ids.map(|id| corner_best[id as usize]);
             if corners.iter().all(|c| c.0 == corners[0].0) {
                 let k = corners[0].0;
                 own.iter_mut().for_each(|o| *o = k);
@@ -920,6 +1086,9 @@ fn shrink(
                 let r = &mut radius[best.0 as usize];
                 *r = r.max(best.2);
             }
+        }
+        for (o, best) in surface.corner_owner.iter_mut().zip(&corner_best) {
+            *o = best.0;
         }
         for (s, &r2) in spheres.iter_mut().zip(&radius) {
             s.radius = padded(r2.sqrt()).min(s.radius);
@@ -961,18 +1130,34 @@ impl Lattice {
 
 /// Gives every piece of the surface to a sphere that holds it (splitting pieces that no single
 /// sphere holds, and growing the sphere that needs the least growth for a piece still unheld at the
-/// split limit), then shrinks every sphere to its pieces. Returns the leaves that hold pieces and
-/// the corners of their pieces.
+/// split limit), then shrinks every sphere to its pieces. A piece whose hinted sphere (`hint`, or
+/// `u32::MAX` for none) holds its corners goes to it without a search. Returns the leaves that
+/// hold pieces and the corners of their pieces.
 fn cover_exact(
     mut spheres: Vec<Sphere>,
-    pieces: &[[Vec3; 3]],
+    pieces: &Pieces,
+    hint: &[u32],
     cell: f32,
 ) -> (Vec<Sphere>, Vec<Vec<Vec3>>) {
     const SPLITS: u32 = 5;
     let grid = SphereGrid::new(&spheres, cell);
     let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
-    for piece in pieces {
-        let mut stack = vec![(*piece, 0u32)];
+    let mut stack = Vec::new();
+    // A numbered corner is listed once per sphere as far as neighbouring pieces show it.
+    let mut mark = vec![u32::MAX; pieces.corner_at.len()];
+    for ((piece, &h), ids) in pieces.corners.iter().zip(hint).zip(&pieces.corner_id) {
+        if let Some(s) = spheres.get(h as usize)
+            && piece.iter().all(|&q| s.contains(q))
+        {
+            for (&q, &id) in piece.iter().zip(ids) {
+                if mark[id as usize] != h {
+                    mark[id as usize] = h;
+                    owned[h as usize].push(q);
+                }
+            }
+            continue;
+        }
+        stack.push((*piece, 0u32));
         while let Some((p, depth)) = stack.pop() {
             let centroid = (p[0] + p[1] + p[2]) / 3.0;
             let near = grid.near(centroid);
@@ -1010,7 +1195,6 @@ fn cover_exact(
             owned[k].extend_from_slice(&p);
         }
     }
-    owned.iter_mut().for_each(dedup);
     for (s, points) in spheres.iter_mut().zip(&owned) {
         let r = points
             .iter()
@@ -1025,58 +1209,74 @@ fn cover_exact(
         .unzip()
 }
 
-/// Removes repeated points (pieces share corners).
-fn dedup(points: &mut Vec<Vec3>) {
-    points.sort_unstable_by(|a, b| {
-        (a.x.to_bits(), a.y.to_bits(), a.z.to_bits()).cmp(&(
-            b.x.to_bits(),
-            b.y.to_bits(),
-            b.z.to_bits(),
-        ))
-    });
-    points.dedup();
-}
-
 /// Moves a leaf's centre to lower its outside volume while it keeps holding `points`: a compass
-/// pattern search (steps from a quarter of the radius down to 2 %, at most 40 trials), the radius
-/// following the farthest point.
-fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3], first_step: f32) -> (Sphere, f32) {
-    // Points relative to the starting centre, in lanes of eight: the farthest point from a trial
-    // centre is a max over squared distances that the compiler vectorises.
+/// pattern search measuring eight trial centres at once (the six axis steps, the last move
+/// repeated and doubled) and moving to the best of them, the step halving when none is better,
+/// from `first_step` of the radius down to 2 %, at most `POLISH_BATCHES` batches; the radius
+/// follows the farthest point. Returns the polished sphere and the longest move it made.
+fn polish(
+    columns: &Columns,
+    local: &mut LocalLines,
+    leaf: Sphere,
+    points: &[Vec3],
+    first_step: f32,
+) -> (Sphere, f32) {
+    // Points relative to the starting centre, eight to a lane (padding repeats the first point,
+    // which changes no maximum). From trial centre c + m, the squared distance to point p is
+    // |p − c|² − 2 m·(p − c) + |m|²: one pass over the points gives the farthest point for all
+    // eight moves.
     let o = leaf.centre;
     let lanes = points.len().div_ceil(8);
     let mut xyz = vec![[[0.0f32; 8]; 3]; lanes];
-    for (k, p) in points.iter().enumerate() {
-        let d = *p - o;
-        xyz[k / 8][0][k % 8] = d.x;
-        xyz[k / 8][1][k % 8] = d.y;
-        xyz[k / 8][2][k % 8] = d.z;
-    }
-    // Padding lanes repeat the first point, which changes no maximum.
-    if let Some(first) = points.first() {
-        let d = *first - o;
-        for k in points.len()..lanes * 8 {
-            xyz[k / 8][0][k % 8] = d.x;
-            xyz[k / 8][1][k % 8] = d.y;
-            xyz[k / 8][2][k % 8] = d.z;
+    for k in 0..lanes * 8 {
+        let d = points.get(k).unwrap_or(&points[0]) - o;
+        for a in 0..3 {
+            xyz[k / 8][a][k % 8] = d[a];
         }
     }
-    let fit = |c: Vec3| {
+    let trials = |c: Vec3, moves: &[Vec3; 8]| -> [Sphere; 8] {
         let rel = c - o;
-        let mut m = [0.0f32; 8];
+        let (cx, cy, cz) = (
+            f32x8::splat(rel.x),
+            f32x8::splat(rel.y),
+            f32x8::splat(rel.z),
+        );
+        let mut far = [f32x8::splat(f32::NEG_INFINITY); 8];
+        let mx = moves.map(|m| f32x8::splat(-2.0 * m.x));
+        let my = moves.map(|m| f32x8::splat(-2.0 * m.y));
+        let mz = moves.map(|m| f32x8::splat(-2.0 * m.z));
         for [x, y, z] in &xyz {
-            for l in 0..8 {
-                let (dx, dy, dz) = (x[l] - rel.x, y[l] - rel.y, z[l] - rel.z);
-                m[l] = m[l].max(dx * dx + dy * dy + dz * dz);
+            let (dx, dy, dz) = (
+                f32x8::from(*x) - cx,
+                f32x8::from(*y) - cy,
+                f32x8::from(*z) - cz,
+            );
+            let d2 = dx * dx + dy * dy + dz * dz;
+            for k in 0..8 {
+                far[k] = far[k].max(d2 + mx[k] * dx + my[k] * dy + mz[k] * dz);
             }
         }
-        let r = m.iter().copied().fold(0.0f32, f32::max).sqrt();
-        let s = Sphere::new(c, padded(r));
-        (columns.outside_volume(&s), s)
+        std::array::from_fn(|k| {
+            let r2 = far[k]
+                .to_array()
+                .into_iter()
+                .fold(f32::NEG_INFINITY, f32::max)
+                + moves[k].length_squared();
+            Sphere::new(c + moves[k], padded(r2.max(0.0).sqrt()))
+        })
     };
-    let (mut best_cost, mut best) = fit(leaf.centre);
-    let mut step = first_step * leaf.radius;
-    let mut largest = 0.0f32;
+    let mut measure = |spheres: &[Sphere; 8], anchor: Vec3, fresh: bool| -> [f64; 8] {
+        if fresh || !spheres.iter().all(|s| local.holds(columns, s)) {
+            // Gathered afresh around the current centre, with room for the next few moves.
+            let need = spheres
+                .iter()
+                .map(|s| s.centre.distance(anchor) + s.radius)
+                .fold(0.0f32, f32::max);
+            columns.gather(anchor, REACH * need, local);
+        }
+
+        local.outside_volumes(columns, spheres)
+    };
     let dirs = [
         Vec3::X,
         Vec3::NEG_X,
@@ -1085,25 +1285,43 @@ fn polish(columns: &Columns, leaf: Sphere, points: &[Vec3], first_step: f32) -> 
         Vec3::Z,
         Vec3::NEG_Z,
     ];
-    let mut evals = 0;
-    // The direction that last lowered the cost is tried first.
-    let mut first = 0;
-    while step > 0.02 * leaf.radius && evals < 40 {
-        let mut moved = false;
-        for t in 0..dirs.len() {
-            let k = (first + t) % dirs.len();
-            let (cost, s) = fit(best.centre + dirs[k] * step);
-            evals += 1;
-            if cost < best_cost {
-                (best_cost, best) = (cost, s);
-                moved = true;
-                largest = largest.max(step);
-                first = k;
-                break;
-            }
+    let mut best = Sphere::new(o, leaf.radius);
+    let mut best_cost = f64::INFINITY;
+    let mut step = first_step * leaf.radius;
+    let mut last_move = Vec3::ZERO;
+    let mut largest = 0.0f32;
+    for batch in 0..POLISH_BATCHES {
+        if step <= 0.02 * leaf.radius {
+            break;
         }
-        if !moved {
+        let c = best.centre;
+        let mut moves = [Vec3::ZERO; 8];
+        for (k, d) in dirs.iter().enumerate() {
+            moves[k] = *d * step;
+        }
+        if batch > 0 && last_move != Vec3::ZERO {
+            moves[6] = last_move;
+            moves[7] = 2.0 * last_move;
+        }
+        let spheres = trials(c, &moves);
+        let costs = measure(&spheres, c, batch == 0);
+        if batch == 0 {
+            // Lane 6 is the start itself.
+            (best, best_cost) = (spheres[6], costs[6]);
+        }
+        let (k, cost) = costs
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+            .expect("eight lanes");
+        if cost < best_cost {
+            last_move = spheres[k].centre - c;
+            largest = largest.max(last_move.length());
+            (best, best_cost) = (spheres[k], cost);
+        } else {
             step *= 0.5;
+            last_move = Vec3::ZERO;
         }
     }
     (best, largest)
@@ -1188,6 +1406,8 @@ mod tests {
             list: Vec::new(),
             pool: Vec::new(),
         };
+        // Groups of one to four candidates over nested prefixes of one member run, as a medial
+        // ball's margins give.
         for k in 0..400 {
             let first = c.pool.len() as u32;
             let len = ((rng() + 0.5) * 30.0) as u32 + 1;
@@ -1197,12 +1417,23 @@ mod tests {
             members.sort_unstable();
             members.dedup();
             c.pool.extend(&members);
-            c.list.push(Candidate {
-                sphere: Sphere::new(Vec3::ZERO, 1.0),
-                first,
-                len: members.len() as u32,
-                cost: ((rng() + 0.5) * 3.0) as f64 * (k % 3) as f64,
-            });
+            let n = members.len() as u32;
+            let sizes = 1 + k % 4;
+            for j in 1..=sizes {
+                let len = (n * j as u32).div_ceil(sizes as u32);
+                if c.list
+                    .last()
+                    .is_some_and(|l| l.first == first && l.len == len)
+                {
+                    continue;
+                }
+                c.list.push(Candidate {
+                    sphere: Sphere::new(Vec3::ZERO, 1.0),
+                    first,
+                    len,
+                    cost: ((rng() + 0.5) * 3.0) as f64 * ((k + j) % 3) as f64,
+                });
+            }
         }
         // Everything coverable: one candidate per piece.
         for i in 0..pieces as u32 {
@@ -1218,28 +1449,32 @@ mod tests {
             let x = &c.list[k];
             &c.pool[x.first as usize..(x.first + x.len) as usize]
         };
-        let initial: Vec<f64> = (0..c.list.len())
-            .map(|k| {
-                members(k)
-                    .iter()
-                    .map(|&i| piece_weight(area[i as usize]))
-                    .sum::<f32>() as f64
-            })
-            .collect();
+        let index = GainIndex::new(&c, &area);
+        // The index counts each piece once per candidate that holds it.
+        for (k, x) in c.list.iter().enumerate() {
+            let held = (0..pieces)
+                .filter(|&i| {
+                    let owners =
+                        &index.owners[index.start[i] as usize..index.start[i + 1] as usize];
+                    (index.group_start[k]..=k as u32).any(|j| owners.contains(&j))
+                })
+                .count();
+            assert_eq!(held, x.len as usize, "candidate {k}");
+        }
         for lambda in [0.0, 0.3, 4.0] {
-            let lazy = greedy(&c, &area, &initial, lambda);
-            let mut open: Vec<f32> = area.iter().map(|&a| piece_weight(a)).collect();
+            let lazy = greedy(&c, &index, lambda);
+            let mut open: Vec<u64> = index.weight.clone();
             let mut plain = Vec::new();
-            while open.iter().any(|&a| a > 0.0) {
+            while open.iter().any(|&a| a > 0) {
                 let key = |k: usize| {
-                    let gain = members(k).iter().map(|&i| open[i as usize]).sum::<f32>() as f64;
+                    let gain = members(k).iter().map(|&i| open[i as usize]).sum::<u64>() as f64;
                     gain / (c.list[k].cost + lambda).max(1e-12)
                 };
                 let best = (0..c.list.len())
                     .max_by(|&a, &b| key(a).total_cmp(&key(b)).then(b.cmp(&a)))
                     .unwrap();
                 for &i in members(best) {
-                    open[i as usize] = 0.0;
+                    open[i as usize] = 0;
                 }
                 plain.push(best as u32);
             }
