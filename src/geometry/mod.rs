@@ -13,6 +13,7 @@ pub mod interval;
 pub mod mass;
 pub mod mesh_distance;
 pub mod pose;
+pub mod ray;
 pub mod sphere;
 pub mod stars;
 pub mod trimesh;

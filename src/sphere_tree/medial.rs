@@ -66,7 +66,7 @@ use super::{
 };
 use crate::geometry::{
     Columns, LocalLines, MeshRef, Sphere, TriMesh, TriangleBvh,
-    mesh_distance::{closest_point_on_mesh, ray_first_hit},
+    mesh_distance::closest_point_on_mesh, ray::ray_first_hit,
 };
 
 /// Growth margins of the candidates, as fractions of the leaf spacing s.
