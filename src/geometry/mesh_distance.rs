@@ -158,8 +158,14 @@ fn to_world(p: TrianglePair, pose: &Pose) -> TrianglePair {
 
 /// Closest point on the mesh surface to `p` (mesh frame), with its distance. Exact.
 pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
+    closest_point_on_mesh_within(m, p, f32::INFINITY)
+}
+
+/// [`closest_point_on_mesh`] among the surface points nearer than `limit` (None if there are
+/// none): boxes farther than the limit are never opened.
+pub fn closest_point_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(Vec3, f32)> {
     let mut best: Option<(Vec3, f32)> = None;
-    let mut best_d2 = f32::INFINITY;
+    let mut best_d2 = limit * limit;
     if m.bvh.nodes.is_empty() {
         return None;
     }

@@ -66,7 +66,7 @@ use super::{
 };
 use crate::geometry::{
     Columns, LocalLines, MeshRef, Sphere, TriMesh, TriangleBvh,
-    mesh_distance::closest_point_on_mesh, ray::ray_first_hit,
+    mesh_distance::closest_point_on_mesh_within, ray::ray_first_hit,
 };
 
 /// Growth margins of the candidates, as fractions of the leaf spacing s.
@@ -203,7 +203,8 @@ fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
     let mut r = ray_first_hit(mesh, p, -n, t_min).map_or(start, |t| (0.5 * t).min(start));
     for _ in 0..40 {
         let c = p - n * r;
-        let Some((q, d)) = closest_point_on_mesh(mesh, c) else {
+        // Only surface nearer than r can shrink the ball.
+        let Some((q, d)) = closest_point_on_mesh_within(mesh, c, r) else {
             break;
         };
         if d >= r - 1e-4 || q.distance_squared(p) < 1e-10 {
