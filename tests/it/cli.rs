@@ -223,6 +223,31 @@ fn trees_reports_covering_octrees_and_writes_sph_files() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// `trees --resolution` rebuilds the teeth at another vertex count (other meshes, other fits);
+/// a count out of range is refused.
+#[test]
+fn trees_take_a_resolution() {
+    let sov = |extra: &[&str]| -> Vec<f64> {
+        let mut args = vec!["trees", "--depth", "2", "--json"];
+        args.extend_from_slice(extra);
+        json_of(&args)["teeth"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["sov_sum"].as_f64().unwrap())
+            .collect()
+    };
+    let default = sov(&[]);
+    assert_eq!(default, sov(&["--resolution", "125"]), "125 is the default");
+    let finer = sov(&["--resolution", "400"]);
+    assert_eq!(finer.len(), default.len());
+    assert_ne!(finer, default);
+    let out = orthosim(&["trees", "--resolution", "5"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--resolution"), "{err}");
+}
+
 #[test]
 fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
     let cache = std::env::temp_dir().join(format!("orthosim-tree-cache-{}", std::process::id()));
