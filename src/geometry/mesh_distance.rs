@@ -218,7 +218,7 @@ fn point_inside_mesh_along(m: MeshRef, p: Vec3, first: Option<Vec3>) -> bool {
         return false;
     }
     if let Some(dir) = first
-        && let Some(inside) = ray_parity(m, p, dir)
+        && let Some(inside) = super::ray::ray_parity(m, p, dir)
     {
         return inside;
     }
@@ -230,83 +230,13 @@ fn point_inside_mesh_along(m: MeshRef, p: Vec3, first: Option<Vec3>) -> bool {
     ];
     let mut votes = 0;
     for (k, dir) in DIRECTIONS.iter().enumerate() {
-        match ray_parity(m, p, *dir) {
+        match super::ray::ray_parity(m, p, *dir) {
             Some(inside) => return inside,
             None if k == DIRECTIONS.len() - 1 => votes += 1,
             None => {}
         }
     }
     votes > 0
-}
-
-/// Parity of ray crossings, or None when the ray passes too close to an edge to be trusted.
-fn ray_parity(m: MeshRef, origin: Vec3, dir: Vec3) -> Option<bool> {
-    let inv = dir.recip();
-    let mut crossings = 0u32;
-    // Depth-first, at most one pending sibling per level: the tree is balanced (median splits),
-    // so a fixed stack of 64 serves any mesh that fits in memory.
-    let (mut stack, mut top) = ([0u32; 64], 1);
-    while top > 0 {
-        top -= 1;
-        let node = m.bvh.nodes[stack[top] as usize];
-        if !ray_hits_box(origin, inv, &node.aabb) {
-            continue;
-        }
-        if node.is_leaf() {
-            for &t in m.bvh.leaf_triangles(&node) {
-                let tri = m.mesh.triangle(t as usize);
-                match ray_triangle(origin, dir, &tri) {
-                    RayHit::Miss => {}
-                    RayHit::Hit => crossings += 1,
-                    RayHit::Ambiguous => return None,
-                }
-            }
-        } else {
-            stack[top] = node.start;
-            stack[top + 1] = node.start + 1;
-            top += 2;
-        }
-    }
-    Some(crossings % 2 == 1)
-}
-
-fn ray_hits_box(o: Vec3, inv: Vec3, b: &Aabb) -> bool {
-    let t1 = (b.min - o) * inv;
-    let t2 = (b.max - o) * inv;
-    let tmin = t1.min(t2).max_element().max(0.0);
-    let tmax = t1.max(t2).min_element();
-    tmin <= tmax
-}
-
-enum RayHit {
-    Miss,
-    Hit,
-    Ambiguous,
-}
-
-fn ray_triangle(o: Vec3, d: Vec3, t: &[Vec3; 3]) -> RayHit {
-    const EDGE_EPS: f32 = 1e-6;
-    let e1 = t[1] - t[0];
-    let e2 = t[2] - t[0];
-    let h = d.cross(e2);
-    let det = e1.dot(h);
-    if det.abs() < 1e-12 * e1.length() * e2.length() {
-        return RayHit::Miss;
-    }
-    let inv = 1.0 / det;
-    let s = o - t[0];
-    let u = inv * s.dot(h);
-    let q = s.cross(e1);
-    let v = inv * d.dot(q);
-    let w = 1.0 - u - v;
-    let dist = inv * e2.dot(q);
-    if dist < 0.0 || u < -EDGE_EPS || v < -EDGE_EPS || w < -EDGE_EPS {
-        return RayHit::Miss;
-    }
-    if u < EDGE_EPS || v < EDGE_EPS || w < EDGE_EPS {
-        return RayHit::Ambiguous;
-    }
-    RayHit::Hit
 }
 
 /// Minimal distance, or penetration estimate, between two posed closed meshes (see the module doc

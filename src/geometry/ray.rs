@@ -1,4 +1,5 @@
-//! The first point where a ray meets a closed mesh, through its bounding-volume hierarchy.
+//! Rays against a closed mesh, through its bounding-volume hierarchy: the first point where one
+//! meets the surface, and the parity of its crossings (the inside test of `mesh_distance`).
 
 use glam::Vec3;
 
@@ -39,6 +40,40 @@ pub fn ray_first_hit(m: MeshRef, origin: Vec3, dir: Vec3, t_min: f32) -> Option<
     best.is_finite().then_some(best)
 }
 
+/// Parity of ray crossings, or None when the ray passes too close to an edge to be trusted.
+pub(super) fn ray_parity(m: MeshRef, origin: Vec3, dir: Vec3) -> Option<bool> {
+    let inv = dir.recip();
+    let mut crossings = 0u32;
+    // Depth-first, at most one pending sibling per level: the tree is balanced (median splits),
+    // so a fixed stack of 64 serves any mesh that fits in memory.
+    let (mut stack, mut top) = ([0u32; 64], 1);
+    while top > 0 {
+        top -= 1;
+        let node = m.bvh.nodes[stack[top] as usize];
+        if ray_box_entry(origin, inv, &node.aabb).is_none() {
+            continue;
+        }
+        if node.is_leaf() {
+            for &t in m.bvh.leaf_triangles(&node) {
+                match crossing(origin, dir, &m.mesh.triangle(t as usize)) {
+                    Some((u, v, dist)) if dist >= 0.0 && inside_by(u, v, -EDGE_EPS) => {
+                        if !inside_by(u, v, EDGE_EPS) {
+                            return None;
+                        }
+                        crossings += 1;
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            stack[top] = node.start;
+            stack[top + 1] = node.start + 1;
+            top += 2;
+        }
+    }
+    Some(crossings % 2 == 1)
+}
+
 /// Where the ray enters the box (0 if it starts inside), or None if it misses it.
 fn ray_box_entry(o: Vec3, inv: Vec3, b: &Aabb) -> Option<f32> {
     let t1 = (b.min - o) * inv;
@@ -48,10 +83,25 @@ fn ray_box_entry(o: Vec3, inv: Vec3, b: &Aabb) -> Option<f32> {
     (tmin <= tmax).then_some(tmin)
 }
 
+/// How near an edge a crossing may pass (barycentric) and still count as a clean hit.
+const EDGE_EPS: f32 = 1e-6;
+
+/// True when all three barycentric coordinates (u, v, 1 − u − v) are at least `margin`.
+fn inside_by(u: f32, v: f32, margin: f32) -> bool {
+    u >= margin && v >= margin && 1.0 - u - v >= margin
+}
+
 /// The ray parameter where `o + t·d` meets the triangle, edges included within 10⁻⁶
 /// (barycentric), for any sign of t; None when it misses or runs parallel to the plane.
 fn ray_triangle_t(o: Vec3, d: Vec3, t: &[Vec3; 3]) -> Option<f32> {
-    const EDGE_EPS: f32 = 1e-6;
+    crossing(o, d, t)
+        .filter(|&(u, v, _)| inside_by(u, v, -EDGE_EPS))
+        .map(|(_, _, dist)| dist)
+}
+
+/// Where the line `o + t·d` crosses the triangle's plane (Möller–Trumbore): barycentric u, v and
+/// the ray parameter t; None when the line runs parallel to the plane.
+fn crossing(o: Vec3, d: Vec3, t: &[Vec3; 3]) -> Option<(f32, f32, f32)> {
     let e1 = t[1] - t[0];
     let e2 = t[2] - t[0];
     let h = d.cross(e2);
@@ -64,10 +114,7 @@ fn ray_triangle_t(o: Vec3, d: Vec3, t: &[Vec3; 3]) -> Option<f32> {
     let u = inv * s.dot(h);
     let q = s.cross(e1);
     let v = inv * d.dot(q);
-    if u < -EDGE_EPS || v < -EDGE_EPS || 1.0 - u - v < -EDGE_EPS {
-        return None;
-    }
-    Some(inv * e2.dot(q))
+    Some((u, v, inv * e2.dot(q)))
 }
 
 #[cfg(test)]

@@ -835,10 +835,11 @@ pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u
             hint[i] = own[0];
             held[own[0] as usize] += 1;
         } else {
-            let mut seen: Vec<u32> = own.to_vec();
-            seen.sort_unstable();
-            seen.dedup();
-            seen.iter().for_each(|&o| held[o as usize] += 1);
+            for (j, &o) in own.iter().enumerate() {
+                if !own[..j].contains(&o) {
+                    held[o as usize] += 1;
+                }
+            }
         }
     }
     let mut order: Vec<usize> = (0..spheres.len()).filter(|&k| held[k] > 0).collect();
