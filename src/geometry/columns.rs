@@ -13,8 +13,8 @@
 //! error of the order of (boundary length in the lattice plane) × cell² for the region, which the
 //! tests bound.
 
+use super::lanes::F8;
 use glam::{DVec3, Vec3};
-use wide::f32x8;
 
 use super::{Sphere, TriMesh};
 
@@ -240,6 +240,7 @@ impl Columns {
     /// `out` (mm³), by the midpoint rule over the lattice (the sphere's own volume included, so the
     /// result is never negative). Radii are measured sixteen at a time, one per lane, in one pass
     /// over the lines.
+    #[inline(always)]
     pub fn outside_volumes(&self, centre: Vec3, radii: &[f32], out: &mut [f64]) {
         out.iter_mut().for_each(|o| *o = 0.0);
         for (radii, out) in radii.chunks(2 * LANES).zip(out.chunks_mut(2 * LANES)) {
@@ -248,6 +249,7 @@ impl Columns {
     }
 
     /// [`Columns::outside_volumes`] for at most 2 × `LANES` radii.
+    #[inline(always)]
     fn outside_volumes_lanes(&self, centre: Vec3, radii: &[f32], out: &mut [f64]) {
         let (u, v) = ((self.axis + 1) % 3, (self.axis + 2) % 3);
         let Some(r_max) = radii.iter().copied().reduce(f32::max) else {
@@ -258,15 +260,15 @@ impl Columns {
             r2[k / LANES][k % LANES] = r * r;
         }
         let halves = radii.len().div_ceil(LANES);
-        let r2 = r2.map(f32x8::from);
+        let r2 = r2.map(F8::from);
         let c = self.cell as f64;
         let (cu, cv, ca) = (centre[u] as f64, centre[v] as f64, centre[self.axis]);
-        let ca8 = f32x8::splat(ca);
+        let ca8 = F8::splat(ca);
         let (i0, i1) = self.index_range(cu, r_max, 0);
         let (j0, j1) = self.index_range(cv, r_max, 1);
         let mut total = [0.0f64; 2 * LANES];
         for i in i0..=i1 {
-            let mut row = [f32x8::ZERO; 2];
+            let mut row = [F8::ZERO; 2];
             let du = (self.line_centre(i, 0)[0] - cu).powi(2);
             for j in j0..=j1 {
                 let x = self.line_centre(i, j);
@@ -287,12 +289,12 @@ impl Columns {
                     }
                 }
                 for (half, acc) in row.iter_mut().enumerate().take(halves) {
-                    let h = (r2[half] - f32x8::splat(d2)).max(f32x8::ZERO).sqrt();
+                    let h = (r2[half] - F8::splat(d2)).max(F8::ZERO).sqrt();
                     let (a, b) = (ca8 - h, ca8 + h);
-                    let mut inside = f32x8::ZERO;
+                    let mut inside = F8::ZERO;
                     if let Some(line) = line {
                         let span = |lo: f32, hi: f32| {
-                            (f32x8::splat(hi).min(b) - f32x8::splat(lo).max(a)).max(f32x8::ZERO)
+                            (F8::splat(hi).min(b) - F8::splat(lo).max(a)).max(F8::ZERO)
                         };
                         inside = span(self.lo0[line], self.hi0[line])
                             + span(self.lo1[line], self.hi1[line]);
@@ -300,10 +302,10 @@ impl Columns {
                             let (ha, hb) = (a.to_array(), b.to_array());
                             let extra: [f32; LANES] =
                                 std::array::from_fn(|k| self.more_inside(line, ha[k], hb[k]));
-                            inside += f32x8::from(extra);
+                            inside += F8::from(extra);
                         }
                     }
-                    *acc += (h + h - inside).max(f32x8::ZERO);
+                    *acc += (h + h - inside).max(F8::ZERO);
                 }
             }
             for (half, acc) in row.iter().enumerate().take(halves) {
@@ -327,8 +329,8 @@ impl Columns {
         if r.is_nan() || r <= 0.0 {
             return 0.0;
         }
-        let (r2, ca8) = (f32x8::splat(r * r), f32x8::splat(ca));
-        let lane = f32x8::from(std::array::from_fn::<f32, LANES, _>(|k| k as f32));
+        let (r2, ca8) = (F8::splat(r * r), F8::splat(ca));
+        let lane = F8::from(std::array::from_fn::<f32, LANES, _>(|k| k as f32));
         let (i0, i1) = self.index_range(cu, r, 0);
         let (j0, j1) = self.index_range(cv, r, 1);
         let mut total = 0.0f64;
@@ -337,7 +339,7 @@ impl Columns {
             if du >= r * r {
                 continue;
             }
-            let mut row = f32x8::ZERO;
+            let mut row = F8::ZERO;
             // The part of the row inside the lattice, eight lines at a time; the rest (no
             // inside intervals) one by one.
             let inner = if i >= 0 && (i as usize) < self.dims[0] {
@@ -357,17 +359,15 @@ impl Columns {
                 let line = i as usize * self.dims[1] + j as usize;
                 let left = (inner.1 - j + 1) as f32;
                 let y0 = (self.line_centre(i, j)[1] - cv) as f32;
-                let dv = f32x8::splat(y0) + lane * f32x8::splat(self.cell);
-                let valid = lane.simd_lt(f32x8::splat(left));
-                let h2 = r2 - f32x8::splat(du) - dv * dv;
-                let h = valid.bitselect(h2.max(f32x8::ZERO).sqrt(), f32x8::ZERO);
+                let dv = F8::splat(y0) + lane * F8::splat(self.cell);
+                let valid = lane.simd_lt(F8::splat(left));
+                let h2 = r2 - F8::splat(du) - dv * dv;
+                let h = valid.select(h2.max(F8::ZERO).sqrt(), F8::ZERO);
                 let (a, b) = (ca8 - h, ca8 + h);
-                let load = |v: &[f32]| {
-                    f32x8::from(<[f32; LANES]>::try_from(&v[line..line + LANES]).unwrap())
-                };
-                let inside = (load(&self.hi0).min(b) - load(&self.lo0).max(a)).max(f32x8::ZERO)
-                    + (load(&self.hi1).min(b) - load(&self.lo1).max(a)).max(f32x8::ZERO);
-                row += (h + h - inside).max(f32x8::ZERO);
+                let load = |v: &[f32]| F8::load(v, line);
+                let inside = (load(&self.hi0).min(b) - load(&self.lo0).max(a)).max(F8::ZERO)
+                    + (load(&self.hi1).min(b) - load(&self.lo1).max(a)).max(F8::ZERO);
+                row += (h + h - inside).max(F8::ZERO);
                 let lines = line..line + (left as usize).min(LANES);
                 if self.more[lines.clone()].contains(&true) {
                     for (k, hk) in lines.zip(h.to_array()) {
@@ -478,6 +478,7 @@ impl Columns {
     /// [`LocalLines::holds`]): every lattice line (on the lattice or off it) that crosses the ball,
     /// except those whose chord through the ball lies inside the solid, which no such sphere's
     /// chord leaves.
+    #[inline(always)]
     pub fn gather(&self, centre: Vec3, reach: f32, out: &mut LocalLines) {
         let (u, v) = ((self.axis + 1) % 3, (self.axis + 2) % 3);
         let (cu, cv) = (centre[u] as f64, centre[v] as f64);
@@ -554,23 +555,23 @@ impl LocalLines {
     /// Volumes of eight spheres outside the solid (mm³), one per lane, by the rule of
     /// [`Columns::outside_volume`] (to f32 rounding). Each sphere must pass
     /// [`LocalLines::holds`]; a lane of radius 0 gives 0.
+    #[inline(always)]
     pub fn outside_volumes(&self, columns: &Columns, spheres: &[Sphere; 8]) -> [f64; 8] {
         let (u, v, a) = ((columns.axis + 1) % 3, (columns.axis + 2) % 3, columns.axis);
-        let lane = |f: &dyn Fn(&Sphere) -> f32| f32x8::from(spheres.each_ref().map(f));
+        let lane = |f: &dyn Fn(&Sphere) -> f32| F8::from(spheres.each_ref().map(f));
         let cu = lane(&|s| s.centre[u] - self.anchor[0]);
         let cv = lane(&|s| s.centre[v] - self.anchor[1]);
         let ca = lane(&|s| s.centre[a] - self.anchor[2]);
         let r2 = lane(&|s| s.radius * s.radius);
-        let mut acc = f32x8::ZERO;
+        let mut acc = F8::ZERO;
         for k in 0..self.u.len() {
-            let (du, dv) = (f32x8::splat(self.u[k]) - cu, f32x8::splat(self.v[k]) - cv);
-            let h = (r2 - du * du - dv * dv).max(f32x8::ZERO).sqrt();
+            let (du, dv) = (F8::splat(self.u[k]) - cu, F8::splat(self.v[k]) - cv);
+            let h = (r2 - du * du - dv * dv).max(F8::ZERO).sqrt();
             let (lo, hi) = (ca - h, ca + h);
-            let inside = (f32x8::splat(self.hi0[k]).min(hi) - f32x8::splat(self.lo0[k]).max(lo))
-                .max(f32x8::ZERO)
-                + (f32x8::splat(self.hi1[k]).min(hi) - f32x8::splat(self.lo1[k]).max(lo))
-                    .max(f32x8::ZERO);
-            acc += (h + h - inside).max(f32x8::ZERO);
+            let inside = (F8::splat(self.hi0[k]).min(hi) - F8::splat(self.lo0[k]).max(lo))
+                .max(F8::ZERO)
+                + (F8::splat(self.hi1[k]).min(hi) - F8::splat(self.lo1[k]).max(lo)).max(F8::ZERO);
+            acc += (h + h - inside).max(F8::ZERO);
         }
         let mut out = acc.to_array().map(|x| x as f64);
         for &(k, line) in &self.more {

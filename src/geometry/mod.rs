@@ -10,6 +10,7 @@ pub mod closest;
 pub mod columns;
 pub mod decimate;
 pub mod interval;
+pub mod lanes;
 pub mod mass;
 pub mod mesh_distance;
 pub mod pose;

@@ -47,6 +47,10 @@
 //!    centres, recursively; each inner sphere is the smallest sphere around the pieces its leaves
 //!    are responsible for, so invariant (2) holds by construction.
 //!
+//! **Instruction sets.** The whole build runs through [`lanes::run`]: on a processor with AVX2 its
+//! lane loops (candidate piece scans and costs, shrinking, polishing) are compiled as 256-bit
+//! operations, elsewhere as SSE2 halves, with the same result bit for bit (tested).
+//!
 //! Guarantee: the coverage invariant holds by construction (step 6 gives every piece of the surface
 //! a leaf that holds its corners; step 7 makes every ancestor hold them), with radii rounded up by a
 //! relative 10⁻⁶ plus 10⁻⁵ mm so that the f32 containment test agrees. At most B^(levels−1) leaves.
@@ -57,8 +61,8 @@
 
 use std::{cmp::Ordering, collections::BinaryHeap};
 
+use crate::geometry::lanes::{self, F8, Job};
 use glam::Vec3;
-use wide::f32x8;
 
 use super::{
     coverage::split4,
@@ -197,7 +201,8 @@ fn split_surface(mesh: &TriMesh, edge: f32) -> Pieces {
 /// The maximal inscribed ball tangent at `p` (outward normal `n`), by shrinking from `start`, or
 /// from half the distance to the surface straight inwards, if that is less: the ball's diameter
 /// along −n runs inside the mesh, so it is an upper bound, and the first ball is then nearly
-/// tight.
+/// tight. It stops when no surface is nearer the centre than the radius less 2 µm (the ball may
+/// cross the surface by that much; the candidates grow it by at least 2.5 % of the leaf spacing).
 fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
     let t_min = 1e-4 * start;
     let mut r = ray_first_hit(mesh, p, -n, t_min).map_or(start, |t| (0.5 * t).min(start));
@@ -207,7 +212,7 @@ fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
         let Some((q, d)) = closest_point_on_mesh_within(mesh, c, r) else {
             break;
         };
-        if d >= r - 1e-4 || q.distance_squared(p) < 1e-10 {
+        if d >= r - 2e-3 || q.distance_squared(p) < 1e-10 {
             break;
         }
         let pq = p - q;
@@ -289,6 +294,7 @@ impl PieceGrid {
 
     /// Calls `f(piece, reach²)` for every piece whose three corners lie within `r` of `c`
     /// (reach = distance to the farthest corner), eight pieces at a time.
+    #[inline(always)]
     fn within(&self, c: Vec3, r: f32, mut f: impl FnMut(u32, f32)) {
         let lo = ((c - Vec3::splat(r) - self.min) / self.cell).floor();
         let hi = ((c + Vec3::splat(r) - self.min) / self.cell).floor();
@@ -296,10 +302,9 @@ impl PieceGrid {
         if hi.x < 0.0 || hi.y < 0.0 || hi.z < 0.0 {
             return;
         }
-        let r2 = f32x8::splat(r * r);
-        let centre = [c.x, c.y, c.z].map(f32x8::splat);
-        let lane = f32x8::from(std::array::from_fn::<f32, 8, _>(|k| k as f32));
-        let load = |v: &[f32], j: usize| f32x8::from(<[f32; 8]>::try_from(&v[j..j + 8]).unwrap());
+        let r2 = F8::splat(r * r);
+        let centre = [c.x, c.y, c.z].map(F8::splat);
+        let lane = F8::from(std::array::from_fn::<f32, 8, _>(|k| k as f32));
         // The distance from the centre to a run of cells along one axis, off the run's axis.
         let gap = |i: usize, axis: usize| {
             let lo = self.min[axis] + i as f32 * self.cell;
@@ -329,14 +334,15 @@ impl PieceGrid {
                 );
                 let mut j = a;
                 while j < b {
-                    let mut reach = f32x8::ZERO;
+                    let mut reach = F8::ZERO;
                     for corner in 0..3 {
-                        let d =
-                            |axis: usize| load(&self.corners[corner * 3 + axis], j) - centre[axis];
+                        let d = |axis: usize| {
+                            F8::load(&self.corners[corner * 3 + axis], j) - centre[axis]
+                        };
                         let (dx, dy, dz) = (d(0), d(1), d(2));
                         reach = reach.max(dx * dx + dy * dy + dz * dz);
                     }
-                    let valid = lane.simd_lt(f32x8::splat((b - j) as f32));
+                    let valid = lane.simd_lt(F8::splat((b - j) as f32));
                     let mut mask = (reach.simd_le(r2) & valid).to_bitmask();
                     if mask != 0 {
                         let reach = reach.to_array();
@@ -376,6 +382,7 @@ struct Candidates {
     pool: Vec<u32>,
 }
 
+#[inline(always)]
 fn candidates(
     m: MeshRef,
     pieces: &Pieces,
@@ -735,6 +742,20 @@ fn prune(c: &Candidates, chosen: &mut Vec<u32>, pieces: usize) {
 
 /// Builds a medial sphere tree with `levels` levels and branching `branching`.
 pub fn build_medial(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> SphereTree {
+    struct Build<'a>(&'a TriMesh, &'a TriangleBvh, u32, u32);
+    impl Job for Build<'_> {
+        type Output = SphereTree;
+        #[inline(always)]
+        fn run(self) -> SphereTree {
+            build(self.0, self.1, self.2, self.3)
+        }
+    }
+    lanes::run(Build(mesh, bvh, branching, levels))
+}
+
+/// [`build_medial`], compiled into each instruction set's caller.
+#[inline(always)]
+fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> SphereTree {
     let levels = levels.max(1);
     let mut tree = SphereTree::empty(branching, levels);
     if mesh.triangles.is_empty() {
@@ -924,11 +945,11 @@ impl SphereGrid {
 /// Eight spheres of a grid cell, by coordinate (padding lanes hold nothing: r² = −1).
 #[derive(Clone, Copy)]
 struct SphereLanes {
-    x: f32x8,
-    y: f32x8,
-    z: f32x8,
-    r2: f32x8,
-    inv_r2: f32x8,
+    x: F8,
+    y: F8,
+    z: F8,
+    r2: F8,
+    inv_r2: F8,
     index: [u32; 8],
 }
 
@@ -970,6 +991,7 @@ impl LaneGrid {
     }
 
     /// Sets each sphere's r² (and its inverse) to the current radius.
+    #[inline(always)]
     fn update(&mut self, spheres: &[Sphere]) {
         for l in &mut self.lanes {
             let mut r2 = l.r2.to_array();
@@ -980,7 +1002,7 @@ impl LaneGrid {
                 }
             }
             l.r2 = r2.into();
-            l.inv_r2 = f32x8::ONE / l.r2;
+            l.inv_r2 = F8::ONE / l.r2;
         }
     }
 
@@ -1031,6 +1053,7 @@ impl<'a> Surface<'a> {
 /// Each numbered piece corner is placed once. A piece whose three corners go to one sphere goes
 /// to it whole: the sphere holds the corners, so (being convex) the whole piece, and its farthest
 /// point from the centre is a corner.
+#[inline(always)]
 fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32) {
     let grid = SphereGrid::new(spheres, cell);
     let mut lanes = LaneGrid::new(&grid, spheres);
@@ -1042,37 +1065,12 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
             lanes.update(spheres);
         }
         radius.iter_mut().for_each(|r| *r = 0.0);
-        let best_of = |p: Vec3, own: usize| {
-            let d2 = p.distance_squared(spheres[own].centre);
-            let r = spheres[own].radius;
-            let mut best = (own as u32, d2 / (r * r), d2);
-            let (px, py, pz) = (f32x8::splat(p.x), f32x8::splat(p.y), f32x8::splat(p.z));
-            for l in lanes.near(&grid, p) {
-                let (dx, dy, dz) = (l.x - px, l.y - py, l.z - pz);
-                let d2 = dx * dx + dy * dy + dz * dz;
-                let ratio = d2 * l.inv_r2;
-                let better = d2.simd_le(l.r2) & ratio.simd_lt(f32x8::splat(best.1));
-                let mut mask = better.to_bitmask();
-                if mask == 0 {
-                    continue;
-                }
-                let (ratio, d2) = (ratio.to_array(), d2.to_array());
-                while mask != 0 {
-                    let k = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if ratio[k] < best.1 {
-                        best = (l.index[k], ratio[k], d2[k]);
-                    }
-                }
-            }
-            best
-        };
         for ((best, &p), own) in corner_best
             .iter_mut()
             .zip(&surface.pieces.corner_at)
             .zip(&surface.corner_owner)
         {
-            *best = best_of(p, *own as usize);
+            *best = best_of(&lanes, &grid, spheres, p, *own as usize);
         }
         for ((piece, own), ids) in surface
             .points
@@ -1091,7 +1089,7 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
             for (j, (&p, o)) in piece.iter().zip(own.iter_mut()).enumerate() {
                 let best = match lattice.corners.iter().position(|&c| c == j) {
                     Some(c) => corners[c],
-                    None => best_of(p, *o as usize),
+                    None => best_of(&lanes, &grid, spheres, p, *o as usize),
                 };
                 *o = best.0;
                 let r = &mut radius[best.0 as usize];
@@ -1105,6 +1103,41 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
             s.radius = padded(r2.sqrt()).min(s.radius);
         }
     }
+}
+
+/// The sphere that holds `p` with the most room (least distance / radius, compared as squares),
+/// starting from its current sphere `own`: (sphere, (distance / radius)², distance²).
+#[inline(always)]
+fn best_of(
+    lanes: &LaneGrid,
+    grid: &SphereGrid,
+    spheres: &[Sphere],
+    p: Vec3,
+    own: usize,
+) -> (u32, f32, f32) {
+    let d2 = p.distance_squared(spheres[own].centre);
+    let r = spheres[own].radius;
+    let mut best = (own as u32, d2 / (r * r), d2);
+    let (px, py, pz) = (F8::splat(p.x), F8::splat(p.y), F8::splat(p.z));
+    for l in lanes.near(grid, p) {
+        let (dx, dy, dz) = (l.x - px, l.y - py, l.z - pz);
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let ratio = d2 * l.inv_r2;
+        let better = d2.simd_le(l.r2) & ratio.simd_lt(F8::splat(best.1));
+        let mut mask = better.to_bitmask();
+        if mask == 0 {
+            continue;
+        }
+        let (ratio, d2) = (ratio.to_array(), d2.to_array());
+        while mask != 0 {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if ratio[k] < best.1 {
+                best = (l.index[k], ratio[k], d2[k]);
+            }
+        }
+    }
+    best
 }
 
 /// The lattice of points on each piece: n + 1 points per edge, how many in all, and which are
@@ -1225,6 +1258,7 @@ fn cover_exact(
 /// repeated and doubled) and moving to the best of them, the step halving when none is better,
 /// from `first_step` of the radius down to 2 %, at most `POLISH_BATCHES` batches; the radius
 /// follows the farthest point. Returns the polished sphere and the longest move it made.
+#[inline(always)]
 fn polish(
     columns: &Columns,
     local: &mut LocalLines,
@@ -1245,63 +1279,6 @@ fn polish(
             xyz[k / 8][a][k % 8] = d[a];
         }
     }
-    // The moves are fixed: ± `step` along each axis (lanes 0–5), then `m` and 2m (lanes 6, 7).
-    let trials = |c: Vec3, step: f32, m: Vec3| -> [Sphere; 8] {
-        let rel = c - o;
-        let (cx, cy, cz) = (
-            f32x8::splat(rel.x),
-            f32x8::splat(rel.y),
-            f32x8::splat(rel.z),
-        );
-        let mut far = [f32x8::splat(f32::NEG_INFINITY); 8];
-        let t = f32x8::splat(2.0 * step);
-        let (mx, my, mz) = (
-            f32x8::splat(2.0 * m.x),
-            f32x8::splat(2.0 * m.y),
-            f32x8::splat(2.0 * m.z),
-        );
-        for [x, y, z] in &xyz {
-            let (dx, dy, dz) = (
-                f32x8::from(*x) - cx,
-                f32x8::from(*y) - cy,
-                f32x8::from(*z) - cz,
-            );
-            let d2 = dx * dx + dy * dy + dz * dz;
-            for (axis, d) in [dx, dy, dz].into_iter().enumerate() {
-                let along = t * d;
-                far[2 * axis] = far[2 * axis].max(d2 - along);
-                far[2 * axis + 1] = far[2 * axis + 1].max(d2 + along);
-            }
-            let md = mx * dx + my * dy + mz * dz;
-            far[6] = far[6].max(d2 - md);
-            far[7] = far[7].max(d2 - md - md);
-        }
-        std::array::from_fn(|k| {
-            let shift = match k {
-                0..6 => DIRS[k] * step,
-                6 => m,
-                _ => 2.0 * m,
-            };
-            let r2 = far[k]
-                .to_array()
-                .into_iter()
-                .fold(f32::NEG_INFINITY, f32::max)
-                + shift.length_squared();
-            Sphere::new(c + shift, padded(r2.max(0.0).sqrt()))
-        })
-    };
-    let mut measure = |spheres: &[Sphere; 8], anchor: Vec3, fresh: bool| -> [f64; 8] {
-        if fresh || !spheres.iter().all(|s| local.holds(columns, s)) {
-            // Gathered afresh around the current centre, with room for the next few moves.
-            let need = spheres
-                .iter()
-                .map(|s| s.centre.distance(anchor) + s.radius)
-                .fold(0.0f32, f32::max);
-            columns.gather(anchor, REACH * need, local);
-        }
-
-        local.outside_volumes(columns, spheres)
-    };
     let mut best = Sphere::new(o, leaf.radius);
     let mut best_cost = f64::INFINITY;
     let mut step = first_step * leaf.radius;
@@ -1313,8 +1290,8 @@ fn polish(
         }
         let c = best.centre;
         let m = if batch > 0 { last_move } else { Vec3::ZERO };
-        let spheres = trials(c, step, m);
-        let costs = measure(&spheres, c, batch == 0);
+        let spheres = trials(&xyz, o, c, step, m);
+        let costs = measure(columns, local, &spheres, c, batch == 0);
         if batch == 0 {
             // Lane 6 is the start itself.
             (best, best_cost) = (spheres[6], costs[6]);
@@ -1335,6 +1312,67 @@ fn polish(
         }
     }
     (best, largest)
+}
+
+/// The eight trial spheres of a polish batch around centre `c`: ± `step` along each axis (lanes
+/// 0–5), then `m` and 2m (lanes 6, 7), each as small as holds the points (`xyz`, relative to `o`,
+/// eight to a lane).
+#[inline(always)]
+fn trials(xyz: &[[[f32; 8]; 3]], o: Vec3, c: Vec3, step: f32, m: Vec3) -> [Sphere; 8] {
+    let rel = c - o;
+    let (cx, cy, cz) = (F8::splat(rel.x), F8::splat(rel.y), F8::splat(rel.z));
+    let mut far = [F8::splat(f32::NEG_INFINITY); 8];
+    let t = F8::splat(2.0 * step);
+    let (mx, my, mz) = (
+        F8::splat(2.0 * m.x),
+        F8::splat(2.0 * m.y),
+        F8::splat(2.0 * m.z),
+    );
+    for [x, y, z] in xyz {
+        let (dx, dy, dz) = (F8::from(*x) - cx, F8::from(*y) - cy, F8::from(*z) - cz);
+        let d2 = dx * dx + dy * dy + dz * dz;
+        for (axis, d) in [dx, dy, dz].into_iter().enumerate() {
+            let along = t * d;
+            far[2 * axis] = far[2 * axis].max(d2 - along);
+            far[2 * axis + 1] = far[2 * axis + 1].max(d2 + along);
+        }
+        let md = mx * dx + my * dy + mz * dz;
+        far[6] = far[6].max(d2 - md);
+        far[7] = far[7].max(d2 - md - md);
+    }
+    std::array::from_fn(|k| {
+        let shift = match k {
+            0..6 => DIRS[k] * step,
+            6 => m,
+            _ => 2.0 * m,
+        };
+        let r2 = far[k]
+            .to_array()
+            .into_iter()
+            .fold(f32::NEG_INFINITY, f32::max)
+            + shift.length_squared();
+        Sphere::new(c + shift, padded(r2.max(0.0).sqrt()))
+    })
+}
+
+/// The outside volumes of eight trial spheres, over the lines gathered around `anchor` (gathered
+/// afresh when `fresh` or when a sphere leaves them, with room for the next few moves).
+#[inline(always)]
+fn measure(
+    columns: &Columns,
+    local: &mut LocalLines,
+    spheres: &[Sphere; 8],
+    anchor: Vec3,
+    fresh: bool,
+) -> [f64; 8] {
+    if fresh || !spheres.iter().all(|s| local.holds(columns, s)) {
+        let need = spheres
+            .iter()
+            .map(|s| s.centre.distance(anchor) + s.radius)
+            .fold(0.0f32, f32::max);
+        columns.gather(anchor, REACH * need, local);
+    }
+    local.outside_volumes(columns, spheres)
 }
 
 /// Places `group` (leaf indices) at slot `node` of `level`: a single leaf sits in the slot itself;
@@ -1509,5 +1547,21 @@ mod tests {
                 c.cmpge(Vec3::splat(-1e-3)).all() && c.cmple(Vec3::new(6.0, 3.0, 2.0) + 1e-3).all()
             }));
         }
+    }
+
+    /// The build compiled for AVX2 (taken on processors that have it) and the portable build give
+    /// the same tree, bit for bit: the lanes round alike in both (see `geometry::lanes`).
+    #[test]
+    fn instruction_sets_build_the_same_tree() {
+        let mesh = crate::teeth::ShapeSet::shared(crate::teeth::ToothResolution::PAPER)
+            .get(crate::teeth::Arch::Upper, crate::teeth::ToothKind::ALL[5])
+            .mesh
+            .clone();
+        let bvh = TriangleBvh::build(&mesh);
+        let chosen = build_medial(&mesh, &bvh, 8, 3);
+        let portable = build(&mesh, &bvh, 8, 3);
+        assert!(chosen.leaves().count() > 30);
+        assert_eq!(chosen.nodes, portable.nodes);
+        assert_eq!(chosen.triangles, portable.triangles);
     }
 }

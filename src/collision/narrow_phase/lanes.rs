@@ -18,8 +18,9 @@
 //! a descent for those instructions and hands it [`Avx2`] lanes, whose tests are single 256-bit
 //! operations; elsewhere it hands it [`Portable`] lanes. Both evaluate the same f32 expressions in
 //! the same order, without fused multiply-adds, so their masks are bit-identical (tested): the
-//! rounding argument above holds for either. This module holds orthosim's only `unsafe` code: the
-//! calls into functions compiled for AVX2, made only after the processor was found to have it.
+//! rounding argument above holds for either. This module and `geometry::lanes` hold orthosim's only
+//! `unsafe` code: calls into functions compiled for AVX2, made only after the processor was found
+//! to have it (and there one SSE instruction, which every x86-64 has).
 
 use glam::{DMat3, DQuat, DVec3, Mat3, Vec3};
 use wide::f32x8;
