@@ -810,11 +810,12 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     shrink(&mut spheres, &mut surface, SHRINK_ROUNDS, s);
     let mut steps = vec![FIRST_STEP; spheres.len()];
     let mut mark = vec![u32::MAX; pieces.corner_at.len()];
+    let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
     for _ in 0..POLISH_ROUNDS {
         mark.fill(u32::MAX);
         // A piece owned whole is represented by its corners (its farthest points from any centre),
         // each corner once per sphere as far as neighbouring pieces show it.
-        let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
+        owned.iter_mut().for_each(Vec::clear);
         let lattice = surface.lattice;
         for ((piece, own), ids) in surface
             .points
