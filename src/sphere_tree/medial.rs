@@ -40,8 +40,10 @@
 //! 6. **Exact cover.** Spheres that hold no points go; if more than the budget hold some, those
 //!    holding the fewest pieces go too. A piece that the lattice gave wholly to a kept sphere goes
 //!    to it; every other triangle piece is split as the coverage check splits it until each part
-//!    lies in one sphere (the one with the most room); a part no sphere holds after five splits —
-//!    a sliver between the points — grows the sphere that needs the least growth. Each sphere then
+//!    lies in one sphere (the one with the most room among the spheres of the piece's lattice
+//!    points, or among all near spheres where one of those was dropped); a part no sphere holds
+//!    after five splits — a sliver between the points — goes to the near sphere with the most
+//!    room that holds it, else grows the one that needs the least growth. Each sphere then
 //!    shrinks to the pieces it is responsible for.
 //! 7. **Hierarchy.** Leaves are split into B balanced groups along the longest axis of their
 //!    centres, recursively; each inner sphere is the smallest sphere around the pieces its leaves
@@ -966,7 +968,12 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         .map(|&h| index.get(h as usize).copied().unwrap_or(u32::MAX))
         .collect();
     let kept: Vec<Sphere> = order.iter().map(|&k| spheres[k]).collect();
-    let (leaves, corners) = cover_exact(kept, &pieces, &hint, s);
+    let lattice_owner: Vec<u32> = surface
+        .owner
+        .iter()
+        .map(|&o| index.get(o as usize).copied().unwrap_or(u32::MAX))
+        .collect();
+    let (leaves, corners) = cover_exact(kept, &pieces, &hint, (&lattice_owner, lattice.len), s);
     let order: Vec<usize> = (0..leaves.len()).collect();
     place(&mut tree, 0, 0, order, &leaves, &corners, mesh);
     tree
@@ -1263,12 +1270,15 @@ impl Lattice {
 /// Gives every piece of the surface to a sphere that holds it (splitting pieces that no single
 /// sphere holds, and growing the sphere that needs the least growth for a piece still unheld at the
 /// split limit), then shrinks every sphere to its pieces. A piece whose hinted sphere (`hint`, or
-/// `u32::MAX` for none) holds its corners goes to it without a search. Returns the leaves that
-/// hold pieces and the corners of their pieces.
+/// `u32::MAX` for none) holds its corners goes to it without a search; any other piece and its
+/// parts look first among the spheres of its lattice points (`lattice_owner`, `per_piece` per
+/// piece; `u32::MAX` for a dropped sphere). Returns the leaves that hold pieces and the corners of
+/// their pieces.
 fn cover_exact(
     mut spheres: Vec<Sphere>,
     pieces: &Pieces,
     hint: &[u32],
+    (lattice_owner, per_piece): (&[u32], usize),
     cell: f32,
 ) -> (Vec<Sphere>, Vec<Vec<Vec3>>) {
     const SPLITS: u32 = 5;
@@ -1277,7 +1287,13 @@ fn cover_exact(
     let mut stack = Vec::new();
     // A numbered corner is listed once per sphere as far as neighbouring pieces show it.
     let mut mark = vec![u32::MAX; pieces.corner_at.len()];
-    for ((piece, &h), ids) in pieces.corners.iter().zip(hint).zip(&pieces.corner_id) {
+    for (i, ((piece, &h), ids)) in pieces
+        .corners
+        .iter()
+        .zip(hint)
+        .zip(&pieces.corner_id)
+        .enumerate()
+    {
         if let Some(s) = spheres.get(h as usize)
             && piece.iter().all(|&q| s.contains(q))
         {
@@ -1289,20 +1305,36 @@ fn cover_exact(
             }
             continue;
         }
+        let lattice = &lattice_owner[i * per_piece..(i + 1) * per_piece];
+        let orphaned = lattice.contains(&u32::MAX);
+        // The distinct spheres of the piece's lattice points.
+        let mut owners = Vec::with_capacity(4);
+        for &k in lattice {
+            if k != u32::MAX && !owners.contains(&k) {
+                owners.push(k);
+            }
+        }
         stack.push((*piece, 0u32));
         while let Some((p, depth)) = stack.pop() {
-            let centroid = (p[0] + p[1] + p[2]) / 3.0;
-            let near = grid.near(centroid);
-            let best = near
-                .iter()
-                .filter(|&&k| p.iter().all(|&q| spheres[k as usize].contains(q)))
-                .map(|&k| {
-                    (
-                        k,
-                        reach(&p, spheres[k as usize].centre) / spheres[k as usize].radius,
-                    )
-                })
-                .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            let most_room = |among: &mut dyn Iterator<Item = u32>| {
+                among
+                    .filter(|&k| p.iter().all(|&q| spheres[k as usize].contains(q)))
+                    .map(|k| {
+                        (
+                            k,
+                            reach(&p, spheres[k as usize].centre) / spheres[k as usize].radius,
+                        )
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+            };
+            // The spheres of the piece's lattice points; every sphere near it only where one of
+            // those was dropped, or before the last resort of growing one.
+            let near = grid.near((p[0] + p[1] + p[2]) / 3.0);
+            let best = most_room(&mut owners.iter().copied()).or_else(|| {
+                (orphaned || depth >= SPLITS)
+                    .then(|| most_room(&mut near.iter().copied()))
+                    .flatten()
+            });
             if let Some((k, _)) = best {
                 owned[k as usize].extend_from_slice(&p);
                 continue;
