@@ -41,7 +41,8 @@ impl Sphere {
     ///
     /// Small sets go to Welzl's algorithm directly. Larger ones keep a core set, starting with the
     /// extreme points along the axes: the smallest sphere around the core set is computed, the
-    /// point farthest outside it joins the set, until no point is outside. A sphere around a
+    /// point farthest outside it in each octant around its centre joins the set, until no point is
+    /// outside. A sphere around a
     /// subset that holds every point is the smallest for all of them, so the answer is the same,
     /// from a few passes over the points instead of Welzl's shuffled recursion over all of them.
     pub fn enclosing(points: &[Vec3]) -> Sphere {
@@ -53,29 +54,50 @@ impl Sphere {
             welzl(points.iter().map(|v| v.as_dvec3()).collect())
         } else {
             let mut core: Vec<DVec3> = Vec::new();
-            for axis in 0..3 {
-                let by = |a: &&Vec3, b: &&Vec3| a[axis].total_cmp(&b[axis]);
-                for q in [points.iter().min_by(by), points.iter().max_by(by)]
-                    .into_iter()
-                    .flatten()
-                {
-                    if !core.contains(&q.as_dvec3()) {
-                        core.push(q.as_dvec3());
+            // The extreme points along each axis, in one pass.
+            let (mut lo, mut hi) = ([points[0]; 3], [points[0]; 3]);
+            for q in points {
+                for axis in 0..3 {
+                    if q[axis] < lo[axis][axis] {
+                        lo[axis] = *q;
                     }
+                    if q[axis] > hi[axis][axis] {
+                        hi[axis] = *q;
+                    }
+                }
+            }
+            for q in lo.into_iter().chain(hi) {
+                if !core.contains(&q.as_dvec3()) {
+                    core.push(q.as_dvec3());
                 }
             }
             loop {
                 let s = welzl(core.clone());
-                // Outside by more than rounding (a point of the core set never is).
+                // Outside by more than rounding (a point of the core set never is): the farthest
+                // such point in each octant around the centre joins the core set.
                 let limit = (s.1 * (1.0 + 1e-9) + 1e-9).powi(2);
-                let far = points
-                    .iter()
-                    .map(|q| (q.as_dvec3().distance_squared(s.0), q))
-                    .filter(|(d2, _)| *d2 > limit)
-                    .max_by(|a, b| a.0.total_cmp(&b.0));
-                match far {
-                    Some((_, q)) if !core.contains(&q.as_dvec3()) => core.push(q.as_dvec3()),
-                    _ => break s,
+                let mut far = [(limit, Vec3::ZERO); 8];
+                for q in points {
+                    let d = q.as_dvec3() - s.0;
+                    let d2 = d.length_squared();
+                    if d2 > limit {
+                        let octant = (d.x > 0.0) as usize
+                            | ((d.y > 0.0) as usize) << 1
+                            | ((d.z > 0.0) as usize) << 2;
+                        if d2 > far[octant].0 {
+                            far[octant] = (d2, *q);
+                        }
+                    }
+                }
+                let before = core.len();
+                for (d2, q) in far {
+                    let q = q.as_dvec3();
+                    if d2 > limit && !core.contains(&q) {
+                        core.push(q);
+                    }
+                }
+                if core.len() == before {
+                    break s;
                 }
             }
         };

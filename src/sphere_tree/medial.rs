@@ -1022,6 +1022,7 @@ impl SphereGrid {
         grid
     }
 
+    #[inline(always)]
     fn cell_of(&self, p: Vec3) -> [usize; 3] {
         let q = ((p - self.min) / self.cell).max(Vec3::ZERO);
         [
@@ -1101,6 +1102,7 @@ impl LaneGrid {
         }
     }
 
+    #[inline(always)]
     fn near(&self, grid: &SphereGrid, p: Vec3) -> &[SphereLanes] {
         let [x, y, z] = grid.cell_of(p);
         let cell = (x * grid.dims[1] + y) * grid.dims[2] + z;
