@@ -856,19 +856,7 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let s = (area / max_leaves as f32).sqrt();
     let pieces = split_surface(mesh, PIECE_EDGE * s);
     let columns = Columns::build(mesh, LINES);
-    // Seeds evenly by area.
-    let n_seeds = (SEEDS_PER_LEAF * max_leaves)
-        .min(MAX_SEEDS)
-        .min(pieces.corners.len());
-    let mut seeds = Vec::with_capacity(n_seeds);
-    let mut carry = 0.0f32;
-    for (i, &a) in pieces.area.iter().enumerate() {
-        carry += a / area * n_seeds as f32;
-        if carry >= 1.0 {
-            carry -= 1.0;
-            seeds.push(i);
-        }
-    }
+    let seeds = seeds_by_area(&pieces, area, max_leaves);
     let cands = candidates(
         m,
         &pieces,
@@ -977,6 +965,24 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let order: Vec<usize> = (0..leaves.len()).collect();
     place(&mut tree, 0, 0, order, &leaves, &corners, mesh);
     tree
+}
+
+/// The medial seeds: `SEEDS_PER_LEAF` per leaf of the budget (at most `MAX_SEEDS`), pieces
+/// spread evenly by area (`area` is the surface's).
+fn seeds_by_area(pieces: &Pieces, area: f32, max_leaves: usize) -> Vec<usize> {
+    let n_seeds = (SEEDS_PER_LEAF * max_leaves)
+        .min(MAX_SEEDS)
+        .min(pieces.corners.len());
+    let mut seeds = Vec::with_capacity(n_seeds);
+    let mut carry = 0.0f32;
+    for (i, &a) in pieces.area.iter().enumerate() {
+        carry += a / area * n_seeds as f32;
+        if carry >= 1.0 {
+            carry -= 1.0;
+            seeds.push(i);
+        }
+    }
+    seeds
 }
 
 /// Sphere indices binned by bounding box on a uniform grid.
@@ -1685,5 +1691,40 @@ mod tests {
         assert!(chosen.leaves().count() > 30);
         assert_eq!(chosen.nodes, portable.nodes);
         assert_eq!(chosen.triangles, portable.triangles);
+    }
+
+    /// On a tooth, the predicted λ gives a cover near its target size without a λ = 0 cover, and
+    /// a larger target is predicted a smaller λ.
+    #[test]
+    fn predicted_lambda_lands_the_cover_near_its_target() {
+        use crate::teeth::{Arch, ShapeSet, ToothKind, ToothResolution};
+        let g = ShapeSet::shared(ToothResolution::PAPER).get(Arch::Lower, ToothKind::ALL[6]);
+        let m = MeshRef {
+            mesh: &g.mesh,
+            bvh: &g.bvh,
+        };
+        let max_leaves = 64;
+        let area = g.mesh.area() as f32;
+        let s = (area / max_leaves as f32).sqrt();
+        let pieces = split_surface(&g.mesh, PIECE_EDGE * s);
+        let seeds = seeds_by_area(&pieces, area, max_leaves);
+        let columns = Columns::build(&g.mesh, CANDIDATE_LINES);
+        let c = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
+        let index = GainIndex::new(&c, &pieces.area);
+        let size = |lambda: f64| {
+            let mut chosen = greedy(&c, &index, lambda);
+            prune(&c, &mut chosen, pieces.area.len());
+            chosen.len() as f64
+        };
+        let target = 60.0;
+        let lambda = predicted_lambda(&c, &index, target).expect("a λ for 60 spheres");
+        let n = size(lambda);
+        assert!(
+            (0.75 * target..=1.25 * target).contains(&n),
+            "{n} spheres at λ {lambda}"
+        );
+        let wider = predicted_lambda(&c, &index, 2.0 * target).expect("a λ for 120 spheres");
+        assert!(wider < lambda && size(wider) > n, "{wider} vs {lambda}");
+        assert!(size(0.0) > 2.0 * target, "λ = 0 is far over both");
     }
 }
