@@ -32,11 +32,12 @@
 //!    holds its points: eight trial centres at a time, their farthest points in one pass over the
 //!    points and their outside volumes in one pass over the lattice lines gathered around the
 //!    sphere ([`LocalLines`], without the lines whose chord stays inside the tooth). Piece corners
-//!    are numbered once, so a corner shared by six pieces is placed once. A piece whose three
-//!    corners go to one sphere goes to it whole, without testing its inner points: the sphere
-//!    holds its corners, so the whole piece, whose farthest point from the centre is a corner. One
-//!    shrinking round, then four rounds of polish and shrink; after the first, a sphere's search
-//!    starts at twice the longest move it made the round before.
+//!    are numbered once, so a corner shared by six pieces is placed once, and so are the points
+//!    inside a piece edge, which the pieces on either side share. A piece whose three corners go
+//!    to one sphere goes to it whole, without testing its inner points: the sphere holds its
+//!    corners, so the whole piece, whose farthest point from the centre is a corner. One shrinking
+//!    round, then four rounds of polish and shrink; after the first, a sphere's search starts at
+//!    twice the longest move it made the round before.
 //! 6. **Exact cover.** Spheres that hold no points go; if more than the budget hold some, those
 //!    holding the fewest pieces go too. A piece that the lattice gave wholly to a kept sphere goes
 //!    to it; every other triangle piece is split as the coverage check splits it until each part
@@ -1117,7 +1118,8 @@ impl LaneGrid {
 }
 
 /// The lattice points of every piece with the sphere each belongs to, and each numbered piece
-/// corner with its sphere.
+/// corner with its sphere. Points inside a piece edge are numbered once per edge (`shared`), so
+/// that the pieces on either side of an edge place them once.
 struct Surface<'a> {
     pieces: &'a Pieces,
     lattice: Lattice,
@@ -1125,6 +1127,10 @@ struct Surface<'a> {
     points: Vec<Vec3>,
     owner: Vec<u32>,
     corner_owner: Vec<u32>,
+    /// Per point: its number among the edge points, or `u32::MAX` for corners and inner points.
+    shared: Vec<u32>,
+    /// How many edge points are numbered.
+    edge_points: usize,
 }
 
 impl<'a> Surface<'a> {
@@ -1132,11 +1138,42 @@ impl<'a> Surface<'a> {
     fn new(pieces: &'a Pieces, piece_owner: &[u32], lattice: Lattice) -> Self {
         let (mut points, mut owner) = (Vec::new(), Vec::new());
         let mut corner_owner = vec![0u32; pieces.corner_at.len()];
+        let roles = lattice.roles();
+        let per_edge = lattice.n - 1;
+        // Edges numbered by their corner numbers: a list of (other corner, edge) per lower corner.
+        let mut head = vec![u32::MAX; pieces.corner_at.len()];
+        let mut links: Vec<(u32, u32)> = Vec::new();
+        let mut shared = Vec::with_capacity(pieces.corners.len() * lattice.len);
         for (i, &corners) in pieces.corners.iter().enumerate() {
             lattice.points_on(corners, &mut points);
             owner.resize(points.len(), piece_owner[i]);
-            for id in pieces.corner_id[i] {
+            let ids = pieces.corner_id[i];
+            for id in ids {
                 corner_owner[id as usize] = piece_owner[i];
+            }
+            let mut edge = |from: u8, to: u8| {
+                let (x, y) = (ids[from as usize], ids[to as usize]);
+                let (lo, hi) = (x.min(y), x.max(y));
+                let mut at = head[lo as usize];
+                while at != u32::MAX && links[at as usize].0 != hi {
+                    at = links[at as usize].1;
+                }
+                if at == u32::MAX {
+                    at = links.len() as u32;
+                    links.push((hi, head[lo as usize]));
+                    head[lo as usize] = at;
+                }
+                (at, x == lo)
+            };
+            for role in &roles {
+                shared.push(match *role {
+                    Role::Edge { from, to, step } => {
+                        let (e, forward) = edge(from, to);
+                        let k = if forward { step } else { lattice.n - step };
+                        e * per_edge + k - 1
+                    }
+                    _ => u32::MAX,
+                });
             }
         }
         Self {
@@ -1145,6 +1182,8 @@ impl<'a> Surface<'a> {
             points,
             owner,
             corner_owner,
+            shared,
+            edge_points: links.len() * per_edge as usize,
         }
     }
 }
@@ -1162,8 +1201,10 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
     let mut lanes = LaneGrid::new(&grid, spheres);
     let mut radius = vec![0.0f32; spheres.len()];
     let mut corner_best = vec![(0u32, 0.0f32, 0.0f32); surface.corner_owner.len()];
+    let mut edge_best = vec![(u32::MAX, 0.0f32, 0.0f32); surface.edge_points];
     let lattice = surface.lattice;
     for round in 0..rounds.max(1) {
+        edge_best.iter_mut().for_each(|b| b.0 = u32::MAX);
         if round > 0 {
             lanes.update(spheres);
         }
@@ -1175,11 +1216,12 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
         {
             *best = best_of(&lanes, &grid, spheres, p, *own as usize);
         }
-        for ((piece, own), ids) in surface
+        for (((piece, own), ids), shared) in surface
             .points
             .chunks(lattice.len)
             .zip(surface.owner.chunks_mut(lattice.len))
             .zip(&surface.pieces.corner_id)
+            .zip(surface.shared.chunks(lattice.len))
         {
             let corners = ids.map(|id| corner_best[id as usize]);
             if corners.iter().all(|c| c.0 == corners[0].0) {
@@ -1192,6 +1234,13 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
             for (j, (&p, o)) in piece.iter().zip(own.iter_mut()).enumerate() {
                 let best = match lattice.corners.iter().position(|&c| c == j) {
                     Some(c) => corners[c],
+                    None if shared[j] != u32::MAX => {
+                        let known = &mut edge_best[shared[j] as usize];
+                        if known.0 == u32::MAX {
+                            *known = best_of(&lanes, &grid, spheres, p, *o as usize);
+                        }
+                        *known
+                    }
                     None => best_of(&lanes, &grid, spheres, p, *o as usize),
                 };
                 *o = best.0;
@@ -1243,6 +1292,15 @@ fn best_of(
     best
 }
 
+/// A lattice point: a piece corner, a point inside the edge from corner `from` to corner `to`
+/// (`step` of n steps from `from`), or a point inside the piece.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    Corner,
+    Edge { from: u8, to: u8, step: u32 },
+    Inner,
+}
+
 /// The lattice of points on each piece: n + 1 points per edge, how many in all, and which are
 /// the corners.
 #[derive(Clone, Copy)]
@@ -1261,6 +1319,38 @@ impl Lattice {
             len,
             corners: [0, len - 1, n as usize],
         }
+    }
+
+    /// What each lattice point is, in `points_on` order.
+    fn roles(&self) -> Vec<Role> {
+        let n = self.n;
+        let mut roles = Vec::with_capacity(self.len);
+        for u in 0..=n {
+            for v in 0..=n - u {
+                roles.push(match (u, v) {
+                    (0, 0) | (0, _) if v == n => Role::Corner,
+                    (_, 0) if u == n => Role::Corner,
+                    (0, 0) => Role::Corner,
+                    (_, 0) => Role::Edge {
+                        from: 0,
+                        to: 1,
+                        step: u,
+                    },
+                    (0, _) => Role::Edge {
+                        from: 0,
+                        to: 2,
+                        step: v,
+                    },
+                    _ if u + v == n => Role::Edge {
+                        from: 1,
+                        to: 2,
+                        step: v,
+                    },
+                    _ => Role::Inner,
+                });
+            }
+        }
+        roles
     }
 
     /// The lattice points of a piece: a + (b − a)·u/n + (c − a)·v/n for u + v ≤ n, u major.
@@ -1726,5 +1816,31 @@ mod tests {
         let wider = predicted_lambda(&c, &index, 2.0 * target).expect("a λ for 120 spheres");
         assert!(wider < lambda && size(wider) > n, "{wider} vs {lambda}");
         assert!(size(0.0) > 2.0 * target, "λ = 0 is far over both");
+    }
+
+    /// Points inside piece edges are numbered once for the two pieces on either side: on a cube,
+    /// whose pieces meet edge to edge, every number is used twice, at one place.
+    #[test]
+    fn edge_points_are_numbered_once_for_both_pieces() {
+        let roles = Lattice::new(3).roles();
+        let count = |f: fn(&Role) -> bool| roles.iter().filter(|r| f(r)).count();
+        assert_eq!(count(|r| *r == Role::Corner), 3);
+        assert_eq!(count(|r| matches!(r, Role::Edge { .. })), 6);
+        assert_eq!(count(|r| *r == Role::Inner), 1);
+        let mesh = cuboid(Vec3::ZERO, Vec3::splat(2.0));
+        let pieces = split_surface(&mesh, 0.3);
+        let owner = vec![0u32; pieces.corners.len()];
+        let surface = Surface::new(&pieces, &owner, Lattice::new(3));
+        assert_eq!(surface.edge_points, 3 * pieces.corners.len());
+        let mut seen: Vec<Vec<Vec3>> = vec![Vec::new(); surface.edge_points];
+        for (p, &k) in surface.points.iter().zip(&surface.shared) {
+            if k != u32::MAX {
+                seen[k as usize].push(*p);
+            }
+        }
+        assert!(
+            seen.iter()
+                .all(|v| v.len() == 2 && v[0].distance(v[1]) < 1e-5)
+        );
     }
 }
