@@ -499,16 +499,24 @@ impl Columns {
         let (i0, i1) = self.index_range(cu, reach, 0);
         let (j0, j1) = self.index_range(cv, reach, 1);
         let ca = centre[self.axis];
+        // Offsets across the lattice, once per row and column.
+        let dvs: Vec<f32> = (j0..=j1)
+            .map(|j| (self.line_centre(0, j)[1] - cv) as f32)
+            .collect();
         for i in i0..=i1 {
-            for j in j0..=j1 {
-                let x = self.line_centre(i, j);
-                let (du, dv) = ((x[0] - cu) as f32, (x[1] - cv) as f32);
-                let h2 = reach * reach - du * du - dv * dv;
+            let du = (self.line_centre(i, 0)[0] - cu) as f32;
+            let room = reach * reach - du * du;
+            if room <= 0.0 {
+                continue;
+            }
+            for (j, &dv) in (j0..=j1).zip(&dvs) {
+                let h2 = room - dv * dv;
                 if h2 <= 0.0 {
                     continue;
                 }
                 let h = h2.sqrt();
-                if let Some(line) = self.line(i, j)
+                let line = self.line(i, j);
+                if let Some(line) = line
                     && self
                         .spans_of(line)
                         .iter()
@@ -523,7 +531,7 @@ impl Columns {
                     [f32::INFINITY, f32::NEG_INFINITY],
                     [f32::INFINITY, f32::NEG_INFINITY],
                 );
-                if let Some(line) = self.line(i, j) {
+                if let Some(line) = line {
                     first = [self.lo0[line] - ca, self.hi0[line] - ca];
                     second = [self.lo1[line] - ca, self.hi1[line] - ca];
                     if self.more[line] {
