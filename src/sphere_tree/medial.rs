@@ -1123,8 +1123,10 @@ impl LaneGrid {
 struct Surface<'a> {
     pieces: &'a Pieces,
     lattice: Lattice,
-    /// Runs of `lattice.len` points per piece, the piece's corners at `lattice.corners`.
+    /// Runs of `lattice.len` points per piece, in `points_on` order.
     points: Vec<Vec3>,
+    /// What each point of a run is.
+    roles: Vec<Role>,
     owner: Vec<u32>,
     corner_owner: Vec<u32>,
     /// Per point: its number among the edge points, or `u32::MAX` for corners and inner points.
@@ -1180,6 +1182,7 @@ impl<'a> Surface<'a> {
             pieces,
             lattice,
             points,
+            roles,
             owner,
             corner_owner,
             shared,
@@ -1231,17 +1234,22 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
                 *r = corners.iter().map(|c| c.2).fold(*r, f32::max);
                 continue;
             }
-            for (j, (&p, o)) in piece.iter().zip(own.iter_mut()).enumerate() {
-                let best = match lattice.corners.iter().position(|&c| c == j) {
-                    Some(c) => corners[c],
-                    None if shared[j] != u32::MAX => {
-                        let known = &mut edge_best[shared[j] as usize];
+            for (((&p, o), role), &shared) in piece
+                .iter()
+                .zip(own.iter_mut())
+                .zip(&surface.roles)
+                .zip(shared)
+            {
+                let best = match role {
+                    Role::Corner(c) => corners[*c as usize],
+                    Role::Edge { .. } => {
+                        let known = &mut edge_best[shared as usize];
                         if known.0 == u32::MAX {
                             *known = best_of(&lanes, &grid, spheres, p, *o as usize);
                         }
                         *known
                     }
-                    None => best_of(&lanes, &grid, spheres, p, *o as usize),
+                    Role::Inner => best_of(&lanes, &grid, spheres, p, *o as usize),
                 };
                 *o = best.0;
                 let r = &mut radius[best.0 as usize];
@@ -1293,32 +1301,27 @@ fn best_of(
 }
 
 /// A lattice point: a piece corner, a point inside the edge from corner `from` to corner `to`
-/// (`step` of n steps from `from`), or a point inside the piece.
+/// (`step` of n steps from `from`), or a point inside the piece. Corners and edges count the
+/// piece's corners 0, 1, 2.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Role {
-    Corner,
+    Corner(u8),
     Edge { from: u8, to: u8, step: u32 },
     Inner,
 }
 
-/// The lattice of points on each piece: n + 1 points per edge, how many in all, and which are
-/// the corners.
+/// The lattice of points on each piece: n + 1 points per edge, and how many in all.
 #[derive(Clone, Copy)]
 struct Lattice {
     n: u32,
     len: usize,
-    corners: [usize; 3],
 }
 
 impl Lattice {
     fn new(n: u32) -> Self {
         let n = n.max(1);
         let len = (n as usize + 1) * (n as usize + 2) / 2;
-        Self {
-            n,
-            len,
-            corners: [0, len - 1, n as usize],
-        }
+        Self { n, len }
     }
 
     /// What each lattice point is, in `points_on` order.
@@ -1328,9 +1331,9 @@ impl Lattice {
         for u in 0..=n {
             for v in 0..=n - u {
                 roles.push(match (u, v) {
-                    (0, 0) | (0, _) if v == n => Role::Corner,
-                    (_, 0) if u == n => Role::Corner,
-                    (0, 0) => Role::Corner,
+                    (0, 0) => Role::Corner(0),
+                    _ if u == n => Role::Corner(1),
+                    _ if v == n => Role::Corner(2),
                     (_, 0) => Role::Edge {
                         from: 0,
                         to: 1,
@@ -1824,7 +1827,10 @@ mod tests {
     fn edge_points_are_numbered_once_for_both_pieces() {
         let roles = Lattice::new(3).roles();
         let count = |f: fn(&Role) -> bool| roles.iter().filter(|r| f(r)).count();
-        assert_eq!(count(|r| *r == Role::Corner), 3);
+        assert_eq!(count(|r| matches!(r, Role::Corner(_))), 3);
+        assert_eq!(roles[0], Role::Corner(0));
+        assert_eq!(roles[9], Role::Corner(1));
+        assert_eq!(roles[3], Role::Corner(2));
         assert_eq!(count(|r| matches!(r, Role::Edge { .. })), 6);
         assert_eq!(count(|r| *r == Role::Inner), 1);
         let mesh = cuboid(Vec3::ZERO, Vec3::splat(2.0));
