@@ -550,8 +550,10 @@ impl Ord for Entry {
 /// piece is covered its weight leaves every increment that holds it, and a gain is zero exactly
 /// when all its pieces are covered.
 struct GainIndex {
-    /// Per candidate: the first candidate of its group.
-    group_start: Vec<u32>,
+    /// The groups (one per medial ball): their candidates are `first..end`.
+    groups: Vec<(u32, u32)>,
+    /// Per candidate: its group.
+    group: Vec<u32>,
     /// Per candidate: the weight of the pieces its increment adds to the group's previous one.
     increment: Vec<u64>,
     /// Per piece: its weight.
@@ -573,18 +575,23 @@ impl GainIndex {
             .iter()
             .map(|&a| ((a.max(0.0) as f64 * unit).round() as u64).max(1))
             .collect();
-        let mut group_start = Vec::with_capacity(c.list.len());
+        let mut groups: Vec<(u32, u32)> = Vec::new();
+        let mut group = Vec::with_capacity(c.list.len());
         let mut increment = Vec::with_capacity(c.list.len());
         let mut count = vec![0u32; area.len() + 1];
         let mut runs = Vec::with_capacity(c.list.len());
         for (k, x) in c.list.iter().enumerate() {
-            let (g, from) = match k.checked_sub(1).map(|j| (j, &c.list[j])) {
-                Some((j, prev)) if prev.first == x.first && prev.len <= x.len => {
-                    (group_start[j], prev.len)
+            let from = match k.checked_sub(1).map(|j| &c.list[j]) {
+                Some(prev) if prev.first == x.first && prev.len <= x.len => {
+                    groups.last_mut().expect("a group has begun").1 = k as u32 + 1;
+                    prev.len
                 }
-                _ => (k as u32, 0),
+                _ => {
+                    groups.push((k as u32, k as u32 + 1));
+                    0
+                }
             };
-            group_start.push(g);
+            group.push(groups.len() as u32 - 1);
             let run = x.first as usize + from as usize..(x.first + x.len) as usize;
             increment.push(
                 c.pool[run.clone()]
@@ -609,7 +616,8 @@ impl GainIndex {
             }
         }
         Self {
-            group_start,
+            groups,
+            group,
             increment,
             weight,
             start: count,
@@ -622,20 +630,35 @@ impl GainIndex {
 /// (cost + λ), ties to the lower index; returns the chosen candidates in order.
 ///
 /// Gains are kept exact as pieces are covered ([`GainIndex`]), and the heap is lazy (Minoux's
-/// accelerated greedy): a candidate's gain only falls, so a stored key is an upper bound; the top
-/// is re-keyed, and taken when its true key still beats the next bound, which makes it the true
-/// best without re-keying every candidate that shares a newly covered piece.
+/// accelerated greedy) with one entry per medial ball, keyed by its best candidate: a gain only
+/// falls, so a stored key is an upper bound; the top ball's candidates are re-keyed together
+/// (their gains are running sums of the group's increments), and its best is taken when it still
+/// beats the next bound, which makes it the true best without re-keying every candidate that
+/// shares a newly covered piece. A ball whose candidate is taken goes back in the heap, since its
+/// larger candidates may still cover more.
 fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32> {
-    let key = |k: usize, gain: u64| gain as f64 / (c.list[k].cost + lambda).max(1e-12);
     let mut increment = index.increment.clone();
-    let gain = |increment: &[u64], k: usize| -> u64 {
-        increment[index.group_start[k] as usize..=k].iter().sum()
+    // A group's best candidate now: the most gain per (cost + λ), ties to the lower index.
+    let best = |increment: &[u64], group: u32| -> Option<Entry> {
+        let (first, end) = index.groups[group as usize];
+        let mut gain = 0u64;
+        let mut best: Option<Entry> = None;
+        for k in first..end {
+            gain += increment[k as usize];
+            if gain > 0 {
+                let entry = Entry(
+                    gain as f64 / (c.list[k as usize].cost + lambda).max(1e-12),
+                    k,
+                );
+                if best.as_ref().is_none_or(|b| entry > *b) {
+                    best = Some(entry);
+                }
+            }
+        }
+        best
     };
-    let mut heap: BinaryHeap<Entry> = (0..c.list.len())
-        .filter_map(|k| {
-            let g = gain(&increment, k);
-            (g > 0).then(|| Entry(key(k, g), k as u32))
-        })
+    let mut heap: BinaryHeap<Entry> = (0..index.groups.len() as u32)
+        .filter_map(|g| best(&increment, g))
         .collect();
     let mut open = vec![true; index.weight.len()];
     let mut uncovered = open.len();
@@ -644,16 +667,15 @@ fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32> {
         let Some(Entry(_, k)) = heap.pop() else {
             break;
         };
-        let k = k as usize;
-        let g = gain(&increment, k);
-        if g == 0 {
+        let group = index.group[k as usize];
+        let Some(entry) = best(&increment, group) else {
             continue;
-        }
-        let entry = Entry(key(k, g), k as u32);
+        };
         if heap.peek().is_some_and(|top| *top > entry) {
             heap.push(entry);
             continue;
         }
+        let k = entry.1 as usize;
         let x = &c.list[k];
         for &i in &c.pool[x.first as usize..(x.first + x.len) as usize] {
             let i = i as usize;
@@ -666,6 +688,10 @@ fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32> {
             }
         }
         chosen.push(k as u32);
+        // The group's larger candidates may still cover more.
+        if let Some(entry) = best(&increment, group) {
+            heap.push(entry);
+        }
     }
     chosen
 }
@@ -783,19 +809,16 @@ const COVER_OVERLAP: f64 = 2.7;
 /// spheres, which falls as λ grows. Solved by bisection on log λ.
 fn predicted_lambda(c: &Candidates, index: &GainIndex, target: f64) -> Option<f64> {
     const STEPS: usize = 14;
-    // Candidate weights (prefix sums of each group's increments) and the groups' ranges.
+    // Candidate weights: prefix sums of each group's increments.
     let mut weight = Vec::with_capacity(c.list.len());
-    let mut groups: Vec<(usize, usize)> = Vec::new();
-    for k in 0..c.list.len() {
-        let g = index.group_start[k] as usize;
-        if g == k {
-            groups.push((k, k + 1));
-            weight.push(index.increment[k] as f64);
-        } else {
-            groups.last_mut().expect("a group has begun").1 = k + 1;
-            weight.push(weight[k - 1] + index.increment[k] as f64);
+    for &(first, end) in &index.groups {
+        let mut sum = 0.0;
+        for k in first..end {
+            sum += index.increment[k as usize] as f64;
+            weight.push(sum);
         }
     }
+    let groups = &index.groups;
     if groups.is_empty() {
         return None;
     }
@@ -806,7 +829,7 @@ fn predicted_lambda(c: &Candidates, index: &GainIndex, target: f64) -> Option<f6
             .iter()
             .map(|&(a, b)| {
                 let mut best = (0.0f64, f64::NEG_INFINITY);
-                for k in a..b {
+                for k in a as usize..b as usize {
                     let score = weight[k] / (c.list[k].cost + lambda).max(1e-300);
                     if score > best.1 {
                         best = (weight[k], score);
@@ -1816,7 +1839,8 @@ mod tests {
                 .filter(|&i| {
                     let owners =
                         &index.owners[index.start[i] as usize..index.start[i + 1] as usize];
-                    (index.group_start[k]..=k as u32).any(|j| owners.contains(&j))
+                    let first = index.groups[index.group[k] as usize].0;
+                    (first..=k as u32).any(|j| owners.contains(&j))
                 })
                 .count();
             assert_eq!(held, x.len as usize, "candidate {k}");
