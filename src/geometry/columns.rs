@@ -225,6 +225,17 @@ impl Columns {
         &self.spans[self.offsets[line] as usize..self.offsets[line + 1] as usize]
     }
 
+    /// True when one inside interval of the line holds the whole of lo..hi.
+    #[inline(always)]
+    fn holds_chord(&self, line: usize, lo: f32, hi: f32) -> bool {
+        (self.lo0[line] <= lo && self.hi0[line] >= hi)
+            || (self.lo1[line] <= lo && self.hi1[line] >= hi)
+            || (self.more[line]
+                && self.spans_of(line)[2..]
+                    .iter()
+                    .any(|s| s[0] <= lo && s[1] >= hi))
+    }
+
     /// Inside length of the line's intervals after its first two, between `lo` and `hi`.
     fn more_inside(&self, line: usize, lo: f32, hi: f32) -> f32 {
         clipped_length(&self.spans_of(line)[2..], lo, hi)
@@ -462,12 +473,9 @@ impl Columns {
 pub struct LocalLines {
     anchor: [f32; 3],
     reach: f32,
-    u: Vec<f32>,
-    v: Vec<f32>,
-    lo0: Vec<f32>,
-    hi0: Vec<f32>,
-    lo1: Vec<f32>,
-    hi1: Vec<f32>,
+    /// Per line: its offsets from the anchor across the lattice (u, v), then its first two
+    /// inside intervals along the axis relative to the anchor (lo0, hi0, lo1, hi1).
+    lines: Vec<[f32; 6]>,
     /// Lines with more than two intervals: (gathered index, lattice line).
     more: Vec<(u32, u32)>,
     cell2: f64,
@@ -485,16 +493,7 @@ impl Columns {
         out.anchor = [centre[u], centre[v], centre[self.axis]];
         out.reach = reach;
         out.cell2 = (self.cell as f64).powi(2);
-        for list in [
-            &mut out.u,
-            &mut out.v,
-            &mut out.lo0,
-            &mut out.hi0,
-            &mut out.lo1,
-            &mut out.hi1,
-        ] {
-            list.clear();
-        }
+        out.lines.clear();
         out.more.clear();
         let (i0, i1) = self.index_range(cu, reach, 0);
         let (j0, j1) = self.index_range(cv, reach, 1);
@@ -509,7 +508,12 @@ impl Columns {
             if room <= 0.0 {
                 continue;
             }
-            for (j, &dv) in (j0..=j1).zip(&dvs) {
+            // The row's lines within the ball: a range a cell wider each way than the circle's,
+            // then the exact test below.
+            let (a, b) = self.index_range(cv, room.sqrt(), 1);
+            let (a, b) = ((a - 1).max(j0), (b + 1).min(j1));
+            for j in a..=b {
+                let dv = dvs[(j - j0) as usize];
                 let h2 = room - dv * dv;
                 if h2 <= 0.0 {
                     continue;
@@ -517,16 +521,11 @@ impl Columns {
                 let h = h2.sqrt();
                 let line = self.line(i, j);
                 if let Some(line) = line
-                    && self
-                        .spans_of(line)
-                        .iter()
-                        .any(|s| s[0] <= ca - h && s[1] >= ca + h)
+                    && self.holds_chord(line, ca - h, ca + h)
                 {
                     continue;
                 }
-                let k = out.u.len() as u32;
-                out.u.push(du);
-                out.v.push(dv);
+                let k = out.lines.len() as u32;
                 let (mut first, mut second) = (
                     [f32::INFINITY, f32::NEG_INFINITY],
                     [f32::INFINITY, f32::NEG_INFINITY],
@@ -538,10 +537,8 @@ impl Columns {
                         out.more.push((k, line as u32));
                     }
                 }
-                out.lo0.push(first[0]);
-                out.hi0.push(first[1]);
-                out.lo1.push(second[0]);
-                out.hi1.push(second[1]);
+                out.lines
+                    .push([du, dv, first[0], first[1], second[0], second[1]]);
             }
         }
     }
@@ -572,13 +569,12 @@ impl LocalLines {
         let ca = lane(&|s| s.centre[a] - self.anchor[2]);
         let r2 = lane(&|s| s.radius * s.radius);
         let mut acc = F8::ZERO;
-        for k in 0..self.u.len() {
-            let (du, dv) = (F8::splat(self.u[k]) - cu, F8::splat(self.v[k]) - cv);
+        for &[lu, lv, lo0, hi0, lo1, hi1] in &self.lines {
+            let (du, dv) = (F8::splat(lu) - cu, F8::splat(lv) - cv);
             let h = (r2 - du * du - dv * dv).max(F8::ZERO).sqrt();
             let (lo, hi) = (ca - h, ca + h);
-            let inside = (F8::splat(self.hi0[k]).min(hi) - F8::splat(self.lo0[k]).max(lo))
-                .max(F8::ZERO)
-                + (F8::splat(self.hi1[k]).min(hi) - F8::splat(self.lo1[k]).max(lo)).max(F8::ZERO);
+            let inside = (F8::splat(hi0).min(hi) - F8::splat(lo0).max(lo)).max(F8::ZERO)
+                + (F8::splat(hi1).min(hi) - F8::splat(lo1).max(lo)).max(F8::ZERO);
             acc += (h + h - inside).max(F8::ZERO);
         }
         let mut out = acc.to_array().map(|x| x as f64);
@@ -586,8 +582,8 @@ impl LocalLines {
             let k = k as usize;
             for (lane, s) in spheres.iter().enumerate() {
                 let (du, dv) = (
-                    self.u[k] - (s.centre[u] - self.anchor[0]),
-                    self.v[k] - (s.centre[v] - self.anchor[1]),
+                    self.lines[k][0] - (s.centre[u] - self.anchor[0]),
+                    self.lines[k][1] - (s.centre[v] - self.anchor[1]),
                 );
                 let h2 = s.radius * s.radius - du * du - dv * dv;
                 if h2 > 0.0 {
