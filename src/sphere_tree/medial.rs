@@ -956,17 +956,18 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         // each corner once per sphere as far as neighbouring pieces show it.
         owned.iter_mut().for_each(Vec::clear);
         let lattice = surface.lattice;
-        for ((piece, own), ids) in surface
+        for (((piece, own), ids), &whole) in surface
             .points
             .chunks(lattice.len)
             .zip(surface.owner.chunks(lattice.len))
             .zip(&pieces.corner_id)
+            .zip(&surface.whole)
         {
-            if own.iter().all(|&o| o == own[0]) {
+            if whole != u32::MAX {
                 for id in ids {
-                    if mark[*id as usize] != own[0] {
-                        mark[*id as usize] = own[0];
-                        owned[own[0] as usize].push(pieces.corner_at[*id as usize]);
+                    if mark[*id as usize] != whole {
+                        mark[*id as usize] = whole;
+                        owned[whole as usize].push(pieces.corner_at[*id as usize]);
                     }
                 }
             } else {
@@ -992,9 +993,9 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let mut hint = vec![u32::MAX; pieces.corners.len()];
     let mut held = vec![0usize; spheres.len()];
     for (i, own) in surface.owner.chunks(lattice.len).enumerate() {
-        if own.iter().all(|&o| o == own[0]) {
-            hint[i] = own[0];
-            held[own[0] as usize] += 1;
+        if surface.whole[i] != u32::MAX {
+            hint[i] = surface.whole[i];
+            held[surface.whole[i] as usize] += 1;
         } else {
             for (j, &o) in own.iter().enumerate() {
                 if !own[..j].contains(&o) {
@@ -1189,6 +1190,8 @@ struct Surface<'a> {
     /// What each point of a run is.
     roles: Vec<Role>,
     owner: Vec<u32>,
+    /// Per piece: the sphere that all its points go to, or `u32::MAX` if they go to several.
+    whole: Vec<u32>,
     corner_owner: Vec<u32>,
     /// Per point: its number among the edge points, or `u32::MAX` for corners and inner points.
     shared: Vec<u32>,
@@ -1245,6 +1248,7 @@ impl<'a> Surface<'a> {
             points,
             roles,
             owner,
+            whole: piece_owner.to_vec(),
             corner_owner,
             shared,
             edge_points: links.len() * per_edge as usize,
@@ -1280,21 +1284,24 @@ fn shrink(spheres: &mut [Sphere], surface: &mut Surface, rounds: u32, cell: f32)
         {
             *best = best_of(&lanes, &grid, spheres, p, *own as usize);
         }
-        for (((piece, own), ids), shared) in surface
+        for ((((piece, own), ids), shared), whole) in surface
             .points
             .chunks(lattice.len)
             .zip(surface.owner.chunks_mut(lattice.len))
             .zip(&surface.pieces.corner_id)
             .zip(surface.shared.chunks(lattice.len))
+            .zip(surface.whole.iter_mut())
         {
             let corners = ids.map(|id| corner_best[id as usize]);
             if corners.iter().all(|c| c.0 == corners[0].0) {
                 let k = corners[0].0;
+                *whole = k;
                 own.iter_mut().for_each(|o| *o = k);
                 let r = &mut radius[k as usize];
                 *r = corners.iter().map(|c| c.2).fold(*r, f32::max);
                 continue;
             }
+            *whole = u32::MAX;
             for (((&p, o), role), &shared) in piece
                 .iter()
                 .zip(own.iter_mut())
