@@ -4,7 +4,7 @@
 //!
 //! 1. **Pieces.** Every triangle is split with [`split4`] (the split the coverage check uses) until
 //!    its pieces are shorter than 0.3 s, where s = √(area / leaf budget) is the leaf spacing.
-//! 2. **Medial centres.** For 6 seeds per leaf of the budget, spread evenly by area, the maximal
+//! 2. **Medial centres.** For 5 seeds per leaf of the budget, spread evenly by area, the maximal
 //!    inscribed ball tangent at the seed, by the shrinking-ball method (Ma, Bae, Choi and Lee
 //!    2012), starting from half the distance to the surface straight inwards (an upper bound on
 //!    the radius) and shrinking in a single pass over the triangle tree, since the balls tangent
@@ -38,7 +38,8 @@
 //!    to one sphere goes to it whole, without testing its inner points: the sphere holds its
 //!    corners, so the whole piece, whose farthest point from the centre is a corner. One shrinking
 //!    round, then four rounds of polish and shrink; after the first, a sphere's search starts at
-//!    twice the longest move it made the round before.
+//!    twice the longest move it made the round before, and from the third round on a sphere
+//!    whose moves the round before were all at most 2 % of its radius is not polished again.
 //! 6. **Exact cover.** Spheres that hold no points go; if more than the budget hold some, those
 //!    holding the fewest pieces go too. A piece that the lattice gave wholly to a kept sphere goes
 //!    to it; every other triangle piece is split as the coverage check splits it until each part
@@ -92,7 +93,7 @@ const PIECE_EDGE: f32 = 0.3;
 /// Most pieces (finer budgets get coarser pieces than `PIECE_EDGE`).
 const MAX_PIECES: usize = 60_000;
 /// Medial seeds per leaf of the budget.
-const SEEDS_PER_LEAF: usize = 6;
+const SEEDS_PER_LEAF: usize = 5;
 /// Most medial seeds.
 const MAX_SEEDS: usize = 6_000;
 /// Points per piece edge (minus one) for the shrinking rounds: a 4 × 4 lattice of points per piece.
@@ -115,10 +116,8 @@ const POLISH_BATCHES: u32 = 10;
 /// The lattice lines gathered for a polish reach this much past the first batch's spheres, so
 /// that the next few moves are measured without gathering again.
 const REACH: f32 = 1.1;
-/// Lattice lines across the tooth for outside volumes while polishing.
-const LINES: usize = 64;
-/// The same for the candidates' costs, which only rank candidates against each other.
-const CANDIDATE_LINES: usize = 48;
+/// Lattice lines across the tooth for outside volumes (the candidates' costs and the polish).
+const LINES: usize = 48;
 /// The cover aims this much over the leaf budget: a few spheres lose all their surface to
 /// neighbours while polishing, and any still over the budget at the end are dropped.
 const COVER_OVERSHOOT: f32 = 1.08;
@@ -919,14 +918,7 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let pieces = split_surface(mesh, PIECE_EDGE * s);
     let columns = Columns::build(mesh, LINES);
     let seeds = seeds_by_area(&pieces, area, max_leaves);
-    let cands = candidates(
-        m,
-        &pieces,
-        &Columns::build(mesh, CANDIDATE_LINES),
-        &seeds,
-        s,
-        max_leaves,
-    );
+    let cands = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
     let chosen = choose(
         &cands,
         &pieces.area,
@@ -950,7 +942,7 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let mut steps = vec![FIRST_STEP; spheres.len()];
     let mut mark = vec![u32::MAX; pieces.corner_at.len()];
     let mut owned: Vec<Vec<Vec3>> = vec![Vec::new(); spheres.len()];
-    for _ in 0..POLISH_ROUNDS {
+    for round in 0..POLISH_ROUNDS {
         mark.fill(u32::MAX);
         // A piece owned whole is represented by its corners (its farthest points from any centre),
         // each corner once per sphere as far as neighbouring pieces show it.
@@ -978,7 +970,8 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         }
         let mut local = LocalLines::default();
         for ((sphere, points), step) in spheres.iter_mut().zip(&owned).zip(&mut steps) {
-            if !points.is_empty() {
+            // From the third round, a sphere that barely moved the round before stays.
+            if !points.is_empty() && !(round >= 2 && *step <= LEAST_FIRST_STEP) {
                 let (polished, moved) = polish(&columns, &mut local, *sphere, points, *step);
                 *sphere = polished;
                 *step = (2.0 * moved / sphere.radius).clamp(LEAST_FIRST_STEP, FIRST_STEP);
@@ -1923,7 +1916,7 @@ mod tests {
         let s = (area / max_leaves as f32).sqrt();
         let pieces = split_surface(&g.mesh, PIECE_EDGE * s);
         let seeds = seeds_by_area(&pieces, area, max_leaves);
-        let columns = Columns::build(&g.mesh, CANDIDATE_LINES);
+        let columns = Columns::build(&g.mesh, LINES);
         let c = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
         let index = GainIndex::new(&c, &pieces.area);
         let size = |lambda: f64| {
