@@ -118,6 +118,8 @@ const POLISH_BATCHES: u32 = 10;
 const REACH: f32 = 1.1;
 /// Lattice lines across the tooth for outside volumes (the candidates' costs and the polish).
 const LINES: usize = 48;
+/// The same for budgets over 512 leaves, whose smaller spheres need a finer lattice.
+const FINE_LINES: usize = 64;
 /// The cover aims this much over the leaf budget: a few spheres lose all their surface to
 /// neighbours while polishing, and any still over the budget at the end are dropped.
 const COVER_OVERSHOOT: f32 = 1.08;
@@ -916,7 +918,7 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
     let area = mesh.area() as f32;
     let s = (area / max_leaves as f32).sqrt();
     let pieces = split_surface(mesh, PIECE_EDGE * s);
-    let columns = Columns::build(mesh, LINES);
+    let columns = Columns::build(mesh, if max_leaves > 512 { FINE_LINES } else { LINES });
     let seeds = seeds_by_area(&pieces, area, max_leaves);
     let cands = candidates(m, &pieces, &columns, &seeds, s, max_leaves);
     let chosen = choose(
