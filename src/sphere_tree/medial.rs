@@ -62,7 +62,7 @@
 //! Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
-//! 0.075 (0.057–0.095), about 506 leaves; see the README for the table and the build times.
+//! 0.077 (0.059–0.099), about 509 leaves; see the README for the table and the build times.
 
 use std::{cmp::Ordering, collections::BinaryHeap};
 
