@@ -973,11 +973,13 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         let mut local = LocalLines::default();
         for ((sphere, points), step) in spheres.iter_mut().zip(&owned).zip(&mut steps) {
             // From the third round, a sphere that barely moved the round before stays.
-            if !points.is_empty() && !(round >= 2 && *step <= LEAST_FIRST_STEP) {
-                let (polished, moved) = polish(&columns, &mut local, *sphere, points, *step);
-                *sphere = polished;
-                *step = (2.0 * moved / sphere.radius).clamp(LEAST_FIRST_STEP, FIRST_STEP);
+            let still = round >= 2 && *step <= LEAST_FIRST_STEP;
+            if points.is_empty() || still {
+                continue;
             }
+            let (polished, moved) = polish(&columns, &mut local, *sphere, points, *step);
+            *sphere = polished;
+            *step = (2.0 * moved / sphere.radius).clamp(LEAST_FIRST_STEP, FIRST_STEP);
         }
         shrink(&mut spheres, &mut surface, 1, s);
     }
