@@ -19,7 +19,7 @@ use super::{
 use crate::geometry::{TriMesh, TriangleBvh};
 
 /// Changes whenever a builder's output changes for the same mesh and settings.
-pub const BUILDER_VERSION: u32 = 12;
+pub const BUILDER_VERSION: u32 = 13;
 
 /// A directory of cached trees.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -37,8 +37,8 @@
 //!    inside a piece edge, which the pieces on either side share. A piece whose three corners go
 //!    to one sphere goes to it whole, without testing its inner points: the sphere holds its
 //!    corners, so the whole piece, whose farthest point from the centre is a corner. One shrinking
-//!    round, then four rounds of polish and shrink; after the first, a sphere's search starts at
-//!    twice the longest move it made the round before, and from the third round on a sphere
+//!    round, then three rounds of polish and shrink; after the first, a sphere's search starts at
+//!    twice the longest move it made the round before, and in the third a sphere
 //!    whose moves the round before were all at most 2 % of its radius is not polished again.
 //! 6. **Exact cover.** Spheres that hold no points go; if more than the budget hold some, those
 //!    holding the fewest pieces go too. A piece that the lattice gave wholly to a kept sphere goes
@@ -101,7 +101,7 @@ const POINT_LATTICE: u32 = 3;
 /// Shrinking rounds after the cover.
 const SHRINK_ROUNDS: u32 = 1;
 /// Rounds of centre polishing, each followed by a shrinking round.
-const POLISH_ROUNDS: u32 = 4;
+const POLISH_ROUNDS: u32 = 3;
 /// The polish's compass directions.
 const DIRS: [Vec3; 6] = [
     Vec3::X,
@@ -972,7 +972,7 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         }
         let mut local = LocalLines::default();
         for ((sphere, points), step) in spheres.iter_mut().zip(&owned).zip(&mut steps) {
-            // From the third round, a sphere that barely moved the round before stays.
+            // In the third round, a sphere that barely moved the round before stays.
             let still = round >= 2 && *step <= LEAST_FIRST_STEP;
             if points.is_empty() || still {
                 continue;
