@@ -21,11 +21,12 @@
 //! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ)),
 //!    evaluated lazily over exact integer gains that are kept current as pieces are covered
 //!    ([`GainIndex`]: a ball's margins share increments, each piece lists the increments that
-//!    hold it). Then spheres whose pieces others cover are dropped. The sum of the costs is the
-//!    paper's `sov_sum` (times the tooth volume) plus λ per leaf; λ is searched (from a guess
-//!    scaled from the λ = 0 cover, then on log λ against log size) so that the cover just fits 8 %
-//!    over the budget B^(levels−1): polishing leaves a few spheres with no surface of their own,
-//!    and step 6 drops any leaves still over the budget.
+//!    hold it; the heap holds one entry per ball). Then spheres whose pieces others cover are
+//!    dropped. The sum of the costs is the paper's `sov_sum` (times the tooth volume) plus λ per
+//!    leaf; λ is searched (from a guess predicted by each ball's best candidate alone, then on
+//!    log λ against log size) so that the cover just fits 8 % over the budget B^(levels−1):
+//!    polishing leaves a few spheres with no surface of their own, and step 6 drops any leaves
+//!    still over the budget.
 //! 5. **Shrink and polish.** The cover is decided on pieces; the spheres are then tightened on a
 //!    lattice of 10 points per piece: each point goes to the sphere that holds it with the most
 //!    room, each sphere shrinks to its points (radii only shrink, so the points stay covered), and
