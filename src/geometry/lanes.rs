@@ -1,7 +1,7 @@
 //! Eight f32 lanes ([`F8`]) written as plain loops over arrays, so that the compiler turns each
 //! operation into vector instructions of whatever instruction set the calling function is compiled
 //! for: two four-lane SSE2 halves in the portable build, one 256-bit operation inside a function
-//! compiled for AVX2 (see [`has_avx2`]).
+//! compiled for AVX2 (see [`run`]).
 //!
 //! Every operation is an IEEE one per lane (no fused multiply-adds, no approximations), so a
 //! computation gives bit-identical results in either instruction set. `max` and `min` return the

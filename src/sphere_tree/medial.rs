@@ -8,9 +8,9 @@
 //!    inscribed ball tangent at the seed, by the shrinking-ball method (Ma, Bae, Choi and Lee
 //!    2012), starting from half the distance to the surface straight inwards (an upper bound on
 //!    the radius) and shrinking in a single pass over the triangle tree, since the balls tangent
-//!    at the seed are nested as they shrink. Its centre lies on the medial axis; a sphere there, slightly larger than the
-//!    ball, bulges out of the tooth only as a flat cap around the tangent points, which is what
-//!    makes medial spheres tight.
+//!    at the seed are nested as they shrink. Its centre lies on the medial axis; a sphere there,
+//!    slightly larger than the ball, bulges out of the tooth only as a flat cap around the
+//!    tangent points, which is what makes medial spheres tight.
 //! 3. **Candidates.** Each medial ball grown by a geometric series of margins (fractions of s). A
 //!    candidate covers the pieces whose three corners it holds and is shrunk to the farthest of
 //!    them; its cost is its volume outside the tooth, by exact line integrals over a lattice
@@ -20,7 +20,7 @@
 //!    feasible.
 //! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ)),
 //!    evaluated lazily over exact integer gains that are kept current as pieces are covered
-//!    ([`GainIndex`]: a ball's margins share increments, each piece lists the increments that
+//!    (`GainIndex`: a ball's margins share increments, each piece lists the increments that
 //!    hold it; the heap holds one entry per ball). Then spheres whose pieces others cover are
 //!    dropped. The sum of the costs is the paper's `sov_sum` (times the tooth volume) plus λ per
 //!    leaf; λ is searched (from a guess predicted by each ball's best candidate alone, then on
@@ -59,8 +59,8 @@
 //!
 //! Guarantee: the coverage invariant holds by construction (step 6 gives every piece of the surface
 //! a leaf that holds its corners; step 7 makes every ancestor hold them), with radii rounded up by a
-//! relative 10⁻⁶ plus 10⁻⁵ mm so that the f32 containment test agrees. At most B^(levels−1) leaves.
-//! Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
+//! relative 10⁻⁶ plus 10⁻⁵ mm so that the f32 containment test agrees. At most B^(levels−1)
+//! leaves. Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
 //! 0.078 (0.060–0.100), about 510 leaves; see the README for the table and the build times.
@@ -707,9 +707,9 @@ fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32> {
 /// The first λ is predicted without a cover ([`predicted_lambda`]). Where even a tiny λ is
 /// predicted to fit, or the first cover is under 95 % of the budget before any was over it,
 /// λ = 0 is tried and taken if it fits (its cover is then the largest); in the first case its
-/// cover gives the guess instead: its mean cost scaled by (its size / target)^1.6. Later runs follow the size as a power
-/// of λ (exponent about −1/2, measured on teeth) until a bracket is found, then interpolate within
-/// the tightest bracket.
+/// cover gives the guess instead: its mean cost scaled by (its size / target)^1.6. Later runs
+/// follow the size as a power of λ (exponent about −1/2, measured on teeth) until a bracket is
+/// found, then interpolate within the tightest bracket.
 fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
     let index = GainIndex::new(c, area);

@@ -30,7 +30,7 @@
 //! rotation axis) per unit time ([`Motion::speed_bound_of`]), so the gap cannot close before
 //! t + d/μ: a step of (d − tolerance/2)/μ leaves at least half the tolerance. Teeth that slide
 //! along each other or turn about their contact close far more slowly than μ, so the step is
-//! extended directionally ([`Relative`]): along the direction n between the closest points, the
+//! extended directionally (`Relative`): along the direction n between the closest points, the
 //! speed of the other tooth's points in the first tooth's frame is an affine function of the point
 //! and its change is bounded, so each candidate pair apart along n provably stays more than half
 //! the tolerance apart for a time that is often several plain steps; the step is the least such

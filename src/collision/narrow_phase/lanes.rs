@@ -82,8 +82,8 @@ impl Affine32 {
     }
 }
 
-/// Bit k set when lane k's sphere (centre (x[k], y[k], z[k]), radius `r[k]`) and the sphere (p, rp) are
-/// within `slack` of touching, for the lanes in `used`.
+/// Bit k set when lane k's sphere (centre `(x[k], y[k], z[k])`, radius `r[k]`) and the sphere
+/// (p, rp) are within `slack` of touching, for the lanes in `used`.
 #[inline]
 pub fn overlap_mask(
     [x, y, z]: [&[f32; LANES]; 3],
@@ -101,8 +101,9 @@ pub fn overlap_mask(
 }
 
 /// Every pair of lanes of two chunks at once: bit l of `rows[k]` is set when lane k of `a` (centre
-/// (a.x[k], a.y[k], a.z[k]), radius a.r[k]) and lane l of `b` are within `slack` of touching, for l
-/// in `used_b` (k over all [`LANES`]; unused lanes of `a` give rows to be masked by the caller).
+/// `(a.x[k], a.y[k], a.z[k])`, radius `a.r[k]`) and lane l of `b` are within `slack` of touching,
+/// for l in `used_b` (k over all [`LANES`]; unused lanes of `a` give rows to be masked by the
+/// caller).
 /// Bit k of `any` is set when `rows[k]` is not empty.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Block {
