@@ -292,10 +292,7 @@ impl Columns {
                 // nothing for any radius.
                 if let Some(line) = line {
                     let h = (r_max * r_max - d2).sqrt();
-                    let (a, b) = (ca - h, ca + h);
-                    if (self.lo0[line] <= a && self.hi0[line] >= b)
-                        || (self.lo1[line] <= a && self.hi1[line] >= b)
-                    {
+                    if self.holds_chord(line, ca - h, ca + h) {
                         continue;
                     }
                 }
@@ -476,6 +473,8 @@ pub struct LocalLines {
     /// Per line: its offsets from the anchor across the lattice (u, v), then its first two
     /// inside intervals along the axis relative to the anchor (lo0, hi0, lo1, hi1).
     lines: Vec<[f32; 6]>,
+    /// Scratch for a gather: the lattice columns' offsets from the anchor.
+    columns_v: Vec<f32>,
     /// Lines with more than two intervals: (gathered index, lattice line).
     more: Vec<(u32, u32)>,
     cell2: f64,
@@ -499,9 +498,9 @@ impl Columns {
         let (j0, j1) = self.index_range(cv, reach, 1);
         let ca = centre[self.axis];
         // Offsets across the lattice, once per row and column.
-        let dvs: Vec<f32> = (j0..=j1)
-            .map(|j| (self.line_centre(0, j)[1] - cv) as f32)
-            .collect();
+        let mut dvs = std::mem::take(&mut out.columns_v);
+        dvs.clear();
+        dvs.extend((j0..=j1).map(|j| (self.line_centre(0, j)[1] - cv) as f32));
         for i in i0..=i1 {
             let du = (self.line_centre(i, 0)[0] - cu) as f32;
             let room = reach * reach - du * du;
@@ -541,6 +540,7 @@ impl Columns {
                     .push([du, dv, first[0], first[1], second[0], second[1]]);
             }
         }
+        out.columns_v = dvs;
     }
 }
 

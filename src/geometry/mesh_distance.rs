@@ -182,10 +182,9 @@ pub fn closest_point_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(
                 let [a, b, c] = m.mesh.triangle(t as usize);
                 // The triangle's box is a lower bound: a triangle clearly beyond the best so far
                 // (by more than the rounding of `d2`) is passed over without the exact query.
-                let gap = (a.min(b).min(c) - p)
-                    .max(p - a.max(b).max(c))
-                    .max(Vec3::ZERO);
-                if gap.length_squared() > best_d2 * (1.0 + 1e-5) {
+                if Aabb::from_points([a, b, c]).distance_squared_to_point(p)
+                    > best_d2 * (1.0 + 1e-5)
+                {
                     continue;
                 }
                 let q = closest_point_triangle(p, a, b, c);

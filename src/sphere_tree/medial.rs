@@ -75,7 +75,7 @@ use super::{
     tree::{SphereTree, triangles_touching},
 };
 use crate::geometry::{
-    Columns, LocalLines, MeshRef, Sphere, TriMesh, TriangleBvh, closest_point_triangle,
+    Aabb, Columns, LocalLines, MeshRef, Sphere, TriMesh, TriangleBvh, closest_point_triangle,
     ray::ray_first_hit,
 };
 
@@ -236,11 +236,9 @@ fn medial_ball(mesh: MeshRef, p: Vec3, n: Vec3, start: f32) -> Sphere {
         if node.is_leaf() {
             for &t in bvh.leaf_triangles(&node) {
                 let [a, b, d] = mesh.mesh.triangle(t as usize);
+                let bounds = Aabb::from_points([a, b, d]);
                 for _ in 0..16 {
-                    let gap = (a.min(b).min(d) - c)
-                        .max(c - a.max(b).max(d))
-                        .max(Vec3::ZERO);
-                    if gap.length_squared() >= inner2 {
+                    if bounds.distance_squared_to_point(c) >= inner2 {
                         break;
                     }
                     let q = closest_point_triangle(c, a, b, d);

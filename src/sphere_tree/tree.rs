@@ -1,8 +1,6 @@
 //! `SphereTree`: the flat B-ary sphere hierarchy in Bradshaw's index layout.
 
-use glam::Vec3;
-
-use crate::geometry::{Sphere, TriMesh, closest_point_triangle};
+use crate::geometry::{Aabb, Sphere, TriMesh, closest_point_triangle};
 
 /// A sphere hierarchy over one mesh (local frame). Node n's children are n·B+1 … n·B+B.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,9 +91,8 @@ pub fn triangles_touching(mesh: &TriMesh, s: &Sphere) -> Vec<u32> {
     (0..mesh.triangles.len() as u32)
         .filter(|&t| {
             let [a, b, c] = mesh.triangle(t as usize);
-            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-            let gap = (lo - s.centre).max(s.centre - hi).max(Vec3::ZERO);
-            gap.length_squared() <= reach2 && s.contains(closest_point_triangle(s.centre, a, b, c))
+            Aabb::from_points([a, b, c]).distance_squared_to_point(s.centre) <= reach2
+                && s.contains(closest_point_triangle(s.centre, a, b, c))
         })
         .collect()
 }
