@@ -17,7 +17,8 @@ fn collision(c: &mut Criterion) {
         branching: 8,
         depth: 4,
     };
-    let teeth = bench::bench_teeth(&d, settings, TreeCache::user_default().as_ref());
+    let teeth = bench::bench_teeth(&d, settings, TreeCache::user_default().as_ref())
+        .expect("valid tree settings");
     let pairs = bench::near_contact_pairs(&teeth, 200, 0x5eed);
     let mut group = c.benchmark_group("collision_200_pairs");
     group.sample_size(10);

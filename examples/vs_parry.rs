@@ -54,7 +54,7 @@ fn main() {
         depth: 4,
     };
     let cache = orthosim::sphere_tree::TreeCache::user_default();
-    let teeth = bench::bench_teeth(&d, settings, cache.as_ref());
+    let teeth = bench::bench_teeth(&d, settings, cache.as_ref()).expect("valid tree settings");
     let pairs = bench::stress_pairs(&teeth, n, 0x5eed);
     let meshes: Vec<PMesh> = teeth
         .iter()

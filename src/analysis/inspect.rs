@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use crate::{
-    geometry::{TriMesh, mesh_separation},
+    geometry::{MeshError, TriMesh, mesh_separation},
     teeth::{Dentition, PlacedTooth, arch::OcclusionMeasures},
 };
 
@@ -95,14 +95,14 @@ fn signed_gap(a: &PlacedTooth, b: &PlacedTooth) -> f32 {
 }
 
 /// Reports on mesh `m`'s validity.
-fn validity(m: &TriMesh) -> Result<(), String> {
-    m.validate_solid().map(|_| ()).map_err(|e| e.to_string())
+fn validity(m: &TriMesh) -> Result<(), MeshError> {
+    m.validate_solid().map(|_| ())
 }
 
 /// Computes the report of a dentition.
 pub fn inspect(d: &Dentition) -> InspectReport {
     // Teeth of one type share a mesh: validate each distinct mesh once.
-    let mut verdicts: std::collections::HashMap<usize, Result<(), String>> = Default::default();
+    let mut verdicts: std::collections::HashMap<usize, Result<(), MeshError>> = Default::default();
     let teeth = d
         .teeth
         .iter()
@@ -122,7 +122,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
                 vertices: m.vertices.len(),
                 triangles: m.triangles.len(),
                 closed: valid.is_ok(),
-                mesh_error: valid.err(),
+                mesh_error: valid.err().map(|e| e.to_string()),
                 volume_mm3: t.geometry.frame.volume_mm3,
                 crown_centre: t.crown_centre().to_array(),
                 extracted: t.extracted,

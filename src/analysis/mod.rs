@@ -9,5 +9,34 @@ pub mod measures;
 pub mod plot;
 pub mod report;
 
+use thiserror::Error;
+
+use crate::{
+    io::OutputError, movement::MovementError, sphere_tree::TreeBuildError, teeth::CaseError,
+};
+
 pub use inspect::{InspectReport, inspect};
-pub use report::{ReportOptions, Summary, run_report};
+pub use report::{ALL_CASES, ReportOptions, Summary, run_report};
+
+/// Why a report could not be made or written.
+#[derive(Debug, Error)]
+pub enum AnalysisError {
+    /// A case could not be read or built.
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    /// A case could not be simulated.
+    #[error(transparent)]
+    Movement(#[from] MovementError),
+    /// Sphere trees could not be built.
+    #[error(transparent)]
+    Trees(#[from] TreeBuildError),
+    /// An output could not or must not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// A plot could not be drawn.
+    #[error("cannot draw a plot: {0}")]
+    Plot(String),
+    /// The summary could not be written as JSON.
+    #[error("cannot write the summary as JSON: {0}")]
+    Json(String),
+}

@@ -6,7 +6,8 @@ use std::{path::Path, sync::OnceLock};
 
 use plotters::{coord::Shift, prelude::*, style::FontStyle};
 
-use super::measures::GAP_FLAG_MM;
+use super::{AnalysisError, measures::GAP_FLAG_MM};
+use crate::io::OutputError;
 
 /// One algorithm's values per pair.
 pub struct Series<'a> {
@@ -43,11 +44,11 @@ fn draw<DB: DrawingBackend>(
     title: &str,
     labels: &[String],
     series: &[Series],
-) -> Result<(), String>
+) -> Result<(), AnalysisError>
 where
     DB::ErrorType: 'static,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| AnalysisError::Plot(e.to_string());
     root.fill(&WHITE).map_err(err)?;
     let root = root.titled(title, (font(), 22)).map_err(err)?;
     let (top, bottom) = root.split_vertically(root.dim_in_pixel().1 / 2);
@@ -136,7 +137,10 @@ where
 }
 
 /// The plot as SVG text.
-pub fn svg(title: &str, labels: &[String], series: &[Series]) -> Result<String, String> {
+///
+/// # Errors
+/// [`AnalysisError::Plot`] when the plot cannot be drawn.
+pub fn svg(title: &str, labels: &[String], series: &[Series]) -> Result<String, AnalysisError> {
     let mut out = String::new();
     {
         let root = SVGBackend::with_string(&mut out, (1100, 760)).into_drawing_area();
@@ -146,7 +150,16 @@ pub fn svg(title: &str, labels: &[String], series: &[Series]) -> Result<String, 
 }
 
 /// The plot as a PNG file at `path` (drawn beside it, then renamed, so no half file is left).
-pub fn png(path: &Path, title: &str, labels: &[String], series: &[Series]) -> Result<(), String> {
+///
+/// # Errors
+/// [`AnalysisError::Plot`] when the plot cannot be drawn, [`AnalysisError::Output`] when it cannot
+/// be moved into place.
+pub fn png(
+    path: &Path,
+    title: &str,
+    labels: &[String],
+    series: &[Series],
+) -> Result<(), AnalysisError> {
     let name = path
         .file_name()
         .map_or_else(|| "plot".into(), |n| n.to_string_lossy().into_owned());
@@ -155,8 +168,11 @@ pub fn png(path: &Path, title: &str, labels: &[String], series: &[Series]) -> Re
         let root = BitMapBackend::new(&tmp, (1100, 760)).into_drawing_area();
         draw(root, title, labels, series)?;
     }
-    std::fs::rename(&tmp, path).map_err(|e| {
+    std::fs::rename(&tmp, path).map_err(|source| {
         let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", path.display())
+        AnalysisError::Output(OutputError::Write {
+            path: path.to_owned(),
+            source,
+        })
     })
 }

@@ -9,10 +9,10 @@
 
 use std::{collections::BTreeMap, fmt::Write as _, path::Path};
 
-use anyhow::{Context, Result};
 use serde::Serialize;
 
 use super::{
+    AnalysisError,
     measures::{
         Bolton, GAP_FLAG_MM, IprEntry, OCCLUSAL_CONTACT_MM, OcclusalContact, Posed, arch_positions,
         bolton, ipr_entries, occlusal_contacts,
@@ -22,11 +22,9 @@ use super::{
 use crate::{
     collision::Method,
     geometry::Pose,
-    movement::{MovementSettings, Response, report::run_case},
-    sphere_tree::{
-        TreeCache, TreeMethod, TreeSettings,
-        report::{refuse_overwriting, trees_report, write_atomic},
-    },
+    io::{OutputError, check_output, write_atomic},
+    movement::{MovementSettings, Response, run_case},
+    sphere_tree::{TreeCache, TreeMethod, TreeSettings, trees_report},
     teeth::{Arch, Case, Dentition},
 };
 
@@ -121,8 +119,11 @@ pub fn run_report(
     opts: &ReportOptions,
     out: &Path,
     progress: &(dyn Fn(&str, usize, usize) + Sync),
-) -> Result<Summary> {
-    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+) -> Result<Summary, AnalysisError> {
+    std::fs::create_dir_all(out).map_err(|source| OutputError::CreateFolder {
+        path: out.to_owned(),
+        source,
+    })?;
     // Outputs never replace inputs: refuse before any work if a file to be written is a case file
     // being read.
     let mut outputs: Vec<std::path::PathBuf> = ["summary.json", "distances.csv", "index.html"]
@@ -138,7 +139,7 @@ pub fn run_report(
     }
     let inputs: Vec<&Path> = opts.cases.iter().map(Path::new).collect();
     for o in &outputs {
-        refuse_overwriting(o, &inputs).map_err(anyhow::Error::msg)?;
+        check_output(o, &inputs)?;
     }
     let total = opts.cases.len() * (Method::ALL.len() + 1) + 2 * opts.fit_depths.len();
     let mut done = 0;
@@ -266,10 +267,9 @@ pub fn run_report(
             })
             .collect();
         let title = format!("{name}: adjacent teeth at rest, per algorithm");
-        let svg = plot::svg(&title, &labels, &series).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let svg = plot::svg(&title, &labels, &series)?;
         write_atomic(&out.join(format!("{name}.svg")), &svg)?;
-        plot::png(&out.join(format!("{name}.png")), &title, &labels, &series)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        plot::png(&out.join(format!("{name}.png")), &title, &labels, &series)?;
         plots.push((name.clone(), svg));
         cases.insert(name, per_method);
     }
@@ -313,19 +313,20 @@ pub fn run_report(
     };
     write_atomic(
         &out.join("summary.json"),
-        &serde_json::to_string_pretty(&summary)?,
+        serde_json::to_string_pretty(&summary).map_err(|e| AnalysisError::Json(e.to_string()))?,
     )?;
     let mut csv =
         String::from("case,algorithm,tooth_a,tooth_b,centre_distance_mm,surface_gap_mm\n");
     for r in &rows {
-        writeln!(
+        // Writing to a String cannot fail.
+        let _ = writeln!(
             csv,
             "{},{},{},{},{:.4},{:.4}",
             r.case, r.algorithm, r.a, r.b, r.centre, r.gap
-        )?;
+        );
     }
     write_atomic(&out.join("distances.csv"), &csv)?;
-    write_atomic(&out.join("index.html"), &html(&summary, &plots))?;
+    write_atomic(&out.join("index.html"), html(&summary, &plots))?;
     progress("done", total, total);
     Ok(summary)
 }

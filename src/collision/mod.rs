@@ -2,20 +2,26 @@
 //!
 //! Engine-free core: [`motion`] (a step's start and end pose and the bounds rotation needs),
 //! [`shape`] (a tooth's compact sphere tree and bounding circle), [`broad_phase`] (arch neighbours and
-//! opposing teeth whose swept root spheres can meet) and [`narrow_phase`] (circles, spheres,
-//! continuous and exact, with their guarantees). ECS layer: [`plugin::CollisionPlugin`].
+//! opposing teeth whose swept root spheres can meet), [`narrow_phase`] (circles, spheres,
+//! continuous and exact, with their guarantees), [`closing`] (whether a contact's teeth close in,
+//! per method, with its tolerances) and [`bench`] (the `orthosim bench` measurements). ECS layer
+//! (feature `ecs`): `CollisionPlugin`.
 
 pub mod bench;
 pub mod broad_phase;
+pub mod closing;
 pub mod motion;
 pub mod narrow_phase;
-pub mod plugin;
+#[cfg(feature = "ecs")]
+mod plugin;
+pub(crate) mod sampling;
 pub mod shape;
 
 pub use motion::Motion;
 pub use narrow_phase::{Body, Method, PairContact, query};
+#[cfg(feature = "ecs")]
 pub use plugin::{
-    CollisionPlugin, CollisionSettings, Contact, ContactStarted, Contacts, SimulationSystems,
-    ToothCollider, ToothContact, ToothMotion,
+    CollisionPlugin, CollisionSettings, CollisionSystems, Contact, ContactStarted, Contacts,
+    ToothCollider, ToothContact, ToothMotion, something_moves,
 };
 pub use shape::{Circle, CollisionShape, CompactTree, collision_shapes};

@@ -7,10 +7,16 @@
 //! event (on the first tooth of the pair) when a pair starts touching. A tooth's motion over the
 //! step is its [`ToothMotion`] (written by the movement stage), else it stands still at its
 //! `Transform`. When nothing moves the broad and narrow phases do not run.
+//!
+//! The systems sit in the chained [`CollisionSystems`] sets; the simulation schedule plugin (a
+//! layer above) nests each in its stage of the simulation step.
 
 use std::{collections::HashSet, sync::Arc};
 
-use bevy::{ecs::schedule::ScheduleLabel, prelude::*};
+use bevy::{
+    ecs::{intern::Interned, schedule::ScheduleLabel},
+    prelude::*,
+};
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -25,21 +31,16 @@ use crate::{
     teeth::{Extracted, Tooth, ToothShape},
 };
 
-/// The simulation's steps, chained in this order in the simulation schedule.
+/// The collision plugin's systems, chained in this order; the simulation schedule puts each in
+/// the stage of the simulation step named in brackets.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SimulationSystems {
-    /// Loads → net force and torque per tooth.
-    Loads,
-    /// Proposed motion of this step per moving tooth.
-    Motion,
-    /// Candidate pairs.
+pub enum CollisionSystems {
+    /// Colliders attached to teeth whose sphere tree is new (`Loads`).
+    Prepare,
+    /// Candidate pairs (`BroadPhase`).
     BroadPhase,
-    /// Contacts of the candidate pairs.
+    /// Contacts of the candidate pairs (`NarrowPhase`).
     NarrowPhase,
-    /// Response to contacts.
-    Resolve,
-    /// End poses written to `Transform`.
-    Commit,
 }
 
 /// Collision settings (RON-serialisable).
@@ -117,15 +118,22 @@ struct Touching(HashSet<(Entity, Entity)>);
 
 /// Collision detection between teeth.
 pub struct CollisionPlugin {
-    /// Schedule the simulation runs in.
-    pub schedule: bevy::ecs::intern::Interned<dyn bevy::ecs::schedule::ScheduleLabel>,
+    schedule: Interned<dyn ScheduleLabel>,
+}
+
+impl CollisionPlugin {
+    /// Collision detection in `schedule` (the simulation's: see [`crate::OrthoSimPlugins`]).
+    pub fn new(schedule: impl ScheduleLabel) -> Self {
+        Self {
+            schedule: schedule.intern(),
+        }
+    }
 }
 
 impl Default for CollisionPlugin {
+    /// Collision detection in `FixedUpdate`.
     fn default() -> Self {
-        Self {
-            schedule: FixedUpdate.intern(),
-        }
+        Self::new(FixedUpdate)
     }
 }
 
@@ -139,25 +147,22 @@ impl Plugin for CollisionPlugin {
             .configure_sets(
                 self.schedule,
                 (
-                    SimulationSystems::Loads,
-                    SimulationSystems::Motion,
-                    SimulationSystems::BroadPhase,
-                    SimulationSystems::NarrowPhase,
-                    SimulationSystems::Resolve,
-                    SimulationSystems::Commit,
+                    CollisionSystems::Prepare,
+                    CollisionSystems::BroadPhase,
+                    CollisionSystems::NarrowPhase,
                 )
                     .chain(),
             )
             .add_systems(
                 self.schedule,
                 (
-                    attach_colliders.before(SimulationSystems::BroadPhase),
+                    attach_colliders.in_set(CollisionSystems::Prepare),
                     broad_phase
                         .run_if(something_moves)
-                        .in_set(SimulationSystems::BroadPhase),
+                        .in_set(CollisionSystems::BroadPhase),
                     narrow_phase
                         .run_if(something_moves)
-                        .in_set(SimulationSystems::NarrowPhase),
+                        .in_set(CollisionSystems::NarrowPhase),
                 ),
             );
     }

@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 
 use crate::{
     geometry::{Pose, Sphere},
-    sphere_tree::{SphereTree, TreeCache, TreeSettings, build::TreeBuildError},
+    sphere_tree::{SphereTree, TreeBuildError, TreeCache, TreeSettings},
     teeth::{Dentition, Fdi, ToothGeometry},
 };
 

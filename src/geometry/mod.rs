@@ -7,10 +7,10 @@
 pub mod aabb;
 pub mod bvh;
 pub mod closest;
-pub mod columns;
+pub(crate) mod columns;
 pub mod decimate;
-pub mod interval;
-pub mod lanes;
+pub(crate) mod interval;
+pub(crate) mod lanes;
 pub mod mass;
 pub mod mesh_distance;
 pub mod pose;
@@ -26,7 +26,7 @@ pub use closest::{
     closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,
     triangle_plane_gap, triangles_intersect,
 };
-pub use columns::{Columns, LocalLines};
+pub(crate) use columns::{Columns, LocalLines};
 pub use mass::MassProperties;
 pub use mesh_distance::{
     MeshRef, MeshSeparation, NearContact, mesh_penetration, mesh_penetration_near, mesh_separation,

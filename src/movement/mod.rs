@@ -1,23 +1,31 @@
 //! Tooth movement: loads, wire models, the quasi-static motion of each step, the next-tooth search
 //! along the arch and the collision responses (block, impulse, IPR).
 //!
-//! Engine-free core: [`settings`] (mobility model and response parameters), [`model`] (load and
-//! wire → motion, constraints), [`arch_path`] (sliding along the arch, next present tooth),
-//! [`sim`] (the whole step over a case, with the responses and their guarantees) and [`report`]
-//! (the `simulate` command's measures). ECS layer: [`plugin::MovementPlugin`].
+//! Engine-free core: `settings` (mobility model and response parameters), `model` (load and
+//! wire → motion, constraints), `arch_path` (sliding along the arch, next present tooth),
+//! [`sim`] (the whole step over a case, with the responses and their guarantees), `report` (the
+//! `simulate` command's measures) and [`MovementError`]. ECS layer (feature `ecs`):
+//! `MovementPlugin`.
 
-pub mod arch_path;
-pub mod model;
-pub mod plugin;
-pub mod report;
-pub mod settings;
+mod arch_path;
+mod error;
+mod model;
+#[cfg(feature = "ecs")]
+mod plugin;
+mod report;
+mod settings;
 pub mod sim;
 
+pub use error::MovementError;
 pub use model::ToothConstraint;
+#[cfg(feature = "ecs")]
 pub use plugin::{
-    MovementPlugin, MovementStatus, SetExtracted, SetGroupLoad, SetLoad, SetWire, SimulationState,
-    ToothImpact,
+    MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad, SetLoad, SetWire,
+    SimulationState, ToothImpact,
 };
-pub use report::{PairDistance, SimulationReport, run_case};
+pub use report::{
+    CaseRun, MOVED_MM, PairDistance, SimulationReport, max_penetration, neighbour_pairs,
+    pair_distances, run_case,
+};
 pub use settings::{MovementSettings, Response};
 pub use sim::{Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome};

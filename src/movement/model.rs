@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | rectangular | force | bodily translation along the force (x, y and z) |
 //! | rectangular | torque | rotation about the crown centre |
-//! | round | force | tipping: rotation about the centre of tipping (1/3 of the root length from the apex, [`crate::teeth::frame::CentreParameters`]) by the force's moment about it; the component along the long axis still extrudes or intrudes |
+//! | round | force | tipping: rotation about the centre of tipping (1/3 of the root length from the apex, [`crate::teeth::CentreParameters`]) by the force's moment about it; the component along the long axis still extrudes or intrudes |
 //! | round | torque | added to the tipping moment |
 //!
 //! Speeds follow [`MovementSettings`]: mobility × (magnitude − threshold) along the load, zero
@@ -22,7 +22,7 @@ use super::{
 };
 use crate::{
     geometry::Pose,
-    teeth::{Fdi, WireModel, arch::ArchCurve, case::Freedoms, frame::ToothFrame},
+    teeth::{Fdi, WireModel, arch::ArchCurve, case::Freedoms},
 };
 
 /// Allowed movements of a tooth (from the case's constraints).
@@ -67,12 +67,13 @@ pub fn excess(v: Vec3, threshold: f32) -> Vec3 {
 }
 
 /// The velocity a load gives a tooth at `pose` under `wire` (before constraints).
+#[cfg(test)]
 pub fn drive(
     force: Vec3,
     torque: Vec3,
     wire: WireModel,
     pose: &Pose,
-    frame: &ToothFrame,
+    frame: &crate::teeth::ToothFrame,
     settings: &MovementSettings,
 ) -> Drive {
     drive_at(
@@ -196,6 +197,7 @@ impl StepMove {
 
 /// One step of a drive applied to a pose on an arch (see [`StepMove`]); `fraction` scales the
 /// whole step (for limits).
+#[cfg(test)]
 pub fn advance(
     curve: &ArchCurve,
     pose: &Pose,

@@ -2,28 +2,54 @@
 //!
 //! Once every visible tooth of the [`ActiveCase`] has its collider (its sphere tree is built), a
 //! [`Simulation`] of the case is made and kept in [`SimulationState`]. Each step of the simulation
-//! schedule (default `FixedUpdate`) then runs its stages in the [`SimulationSystems`] sets:
-//! `Loads` (loads set by [`SetLoad`] messages or changed [`Load`] components), `Motion` (each
-//! tooth's [`ToothMotion`] for the step), the collision plugin's `BroadPhase` and `NarrowPhase`,
-//! `Resolve` (the response to the [`Contacts`], see [`super::sim`]) and `Commit` (end poses
-//! written to `Transform`, [`MovementStatus`] updated, a [`ToothImpact`] message per impact).
-//! A new case, or a change of the collision method, starts a new simulation.
+//! schedule (default `FixedUpdate`) then runs the plugin's [`MovementSystems`], each nested in its
+//! stage of [`SimulationSystems`]: `Start` and `Loads` in `Loads` (the simulation made or
+//! restarted; wires, extractions and loads set by messages or changed [`Load`] components),
+//! `Propose` in `Motion` (each tooth's [`ToothMotion`] for the step), `Clock` at the start of
+//! `BroadPhase` (the collision time is measured from there), `Resolve` (the response to the
+//! [`Contacts`], see [`super::sim`]) and `Commit` (end poses written to `Transform`,
+//! [`MovementStatus`] updated, a [`ToothImpact`] message per impact). A new case, or a change of
+//! the collision method, starts a new simulation.
 
 use std::sync::Arc;
 
-use bevy::{ecs::schedule::ScheduleLabel, prelude::*};
+use bevy::{
+    ecs::{intern::Interned, schedule::ScheduleLabel},
+    prelude::*,
+};
 
 use super::{
+    MovementError,
     settings::MovementSettings,
     sim::{Found, Impact, Simulation},
 };
 use crate::{
     collision::{
-        CollisionSettings, Contacts, PairContact, SimulationSystems, ToothCollider, ToothMotion,
+        CollisionSettings, CollisionSystems, Contacts, PairContact, ToothCollider, ToothMotion,
         motion::Motion,
     },
+    simulation::{SimulationSystems, ensure_schedule},
     teeth::{ActiveCase, Dentition, Extracted, Load, Tooth, Wire, WireModel},
 };
+
+/// The movement plugin's systems, in the order they run; each sits in the stage of
+/// [`SimulationSystems`] named in brackets.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MovementSystems {
+    /// The simulation made when a case is ready, restarted when it changes (`Loads`, after the
+    /// colliders are attached).
+    Start,
+    /// Wires, extractions and loads asked for by messages or changed components (`Loads`).
+    Loads,
+    /// Each tooth's proposed motion (`Motion`).
+    Propose,
+    /// The collision time starts (`BroadPhase`, before the collision plugin's broad phase).
+    Clock,
+    /// The response to the step's contacts (`Resolve`).
+    Resolve,
+    /// End poses written, status and messages (`Commit`).
+    Commit,
+}
 
 /// The running simulation of the active case.
 #[derive(Resource, Default)]
@@ -109,21 +135,32 @@ pub struct ToothImpact(pub Impact);
 
 /// Tooth movement and the response to contacts.
 pub struct MovementPlugin {
-    /// Schedule the simulation runs in (the collision plugin's).
-    pub schedule: bevy::ecs::intern::Interned<dyn ScheduleLabel>,
+    schedule: Interned<dyn ScheduleLabel>,
+}
+
+impl MovementPlugin {
+    /// Tooth movement in `schedule` (the simulation's: see [`crate::OrthoSimPlugins`]).
+    pub fn new(schedule: impl ScheduleLabel) -> Self {
+        Self {
+            schedule: schedule.intern(),
+        }
+    }
 }
 
 impl Default for MovementPlugin {
+    /// Tooth movement in `FixedUpdate`.
     fn default() -> Self {
-        Self {
-            schedule: FixedUpdate.intern(),
-        }
+        Self::new(FixedUpdate)
     }
 }
 
 impl Plugin for MovementPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<MovementSettings>()
+        ensure_schedule(app, self.schedule);
+        // What movement reads of collision, there even when another plugin replaces it.
+        app.init_resource::<CollisionSettings>()
+            .init_resource::<Contacts>()
+            .init_resource::<MovementSettings>()
             .init_resource::<SimulationState>()
             .init_resource::<MovementStatus>()
             .init_resource::<CollisionClock>()
@@ -132,19 +169,32 @@ impl Plugin for MovementPlugin {
             .add_message::<SetWire>()
             .add_message::<SetExtracted>()
             .add_message::<ToothImpact>()
+            .configure_sets(
+                self.schedule,
+                (
+                    (MovementSystems::Start, MovementSystems::Loads)
+                        .chain()
+                        .in_set(SimulationSystems::Loads)
+                        .after(CollisionSystems::Prepare),
+                    MovementSystems::Propose.in_set(SimulationSystems::Motion),
+                    MovementSystems::Clock
+                        .in_set(SimulationSystems::BroadPhase)
+                        .before(CollisionSystems::BroadPhase),
+                    MovementSystems::Resolve.in_set(SimulationSystems::Resolve),
+                    MovementSystems::Commit.in_set(SimulationSystems::Commit),
+                ),
+            )
             .add_systems(
                 self.schedule,
                 (
-                    start_simulation.before(SimulationSystems::Loads),
+                    start_simulation.in_set(MovementSystems::Start),
                     (edit_teeth, apply_loads)
                         .chain()
-                        .in_set(SimulationSystems::Loads),
-                    propose.in_set(SimulationSystems::Motion),
-                    start_clock
-                        .after(SimulationSystems::Motion)
-                        .before(SimulationSystems::BroadPhase),
-                    resolve.in_set(SimulationSystems::Resolve),
-                    commit.in_set(SimulationSystems::Commit),
+                        .in_set(MovementSystems::Loads),
+                    propose.in_set(MovementSystems::Propose),
+                    start_clock.in_set(MovementSystems::Clock),
+                    resolve.in_set(MovementSystems::Resolve),
+                    commit.in_set(MovementSystems::Commit),
                 ),
             );
     }
@@ -255,7 +305,7 @@ fn edit_teeth(
             Ok(next) => next,
             Err(e) => {
                 warn!("{e}");
-                state.notice = Some(e);
+                state.notice = Some(e.to_string());
                 continue;
             }
         };
@@ -303,23 +353,20 @@ fn apply_loads(
         group_messages.clear();
         return;
     };
-    let mut refuse = |e: String| {
+    let mut refuse = |e: MovementError| {
         warn!("{e}");
-        state.notice = Some(e);
+        state.notice = Some(e.to_string());
     };
     for m in group_messages.read() {
         match (sim.groups.get_mut(m.group), m.load.check()) {
             (Some(g), Ok(())) => g.load = m.load,
-            (Some(_), Err(e)) => refuse(e),
-            (None, _) => refuse(format!(
-                "a load for group {} was refused: no such group",
-                m.group
-            )),
+            (Some(_), Err(e)) => refuse(e.into()),
+            (None, _) => refuse(MovementError::NoGroup(m.group)),
         }
     }
     for m in messages.read() {
         if let Err(e) = m.load.check() {
-            refuse(e);
+            refuse(e.into());
             continue;
         }
         if let Ok((_, mut l)) = loads.get_mut(m.tooth) {

@@ -10,7 +10,7 @@ use std::{collections::BTreeMap, time::Instant};
 
 use serde::Serialize;
 
-use super::{settings::MovementSettings, sim::Simulation};
+use super::{MovementError, settings::MovementSettings, sim::Simulation};
 use crate::{
     collision::{Method, shape::collision_shapes},
     geometry::mesh_separation,
@@ -150,6 +150,10 @@ pub struct CaseRun {
 
 /// Loads a case, builds its teeth's trees (`cache` if given), and steps until the teeth rest or
 /// `max_steps` pass; `progress(step)` is called after every step.
+///
+/// # Errors
+/// The case cannot be read or built, its trees cannot be built, or the simulation cannot be made
+/// (each [`MovementError`] names the case or file).
 pub fn run_case(
     case: &str,
     method: Method,
@@ -158,13 +162,16 @@ pub fn run_case(
     cache: Option<&TreeCache>,
     max_steps: u64,
     mut progress: impl FnMut(u64),
-) -> anyhow::Result<CaseRun> {
+) -> Result<CaseRun, MovementError> {
     let loaded = Case::resolve(case)?;
     let name = loaded.case.name.clone();
     let d = Dentition::build(loaded)?;
     let shapes = collision_shapes(&d, trees, cache)?;
-    let mut sim = Simulation::new(&d, shapes, method, settings)
-        .map_err(|e| anyhow::anyhow!("{case}: {e}"))?;
+    let mut sim =
+        Simulation::new(&d, shapes, method, settings).map_err(|e| MovementError::InCase {
+            case: case.to_owned(),
+            source: Box::new(e),
+        })?;
     let start = Instant::now();
     let mut collision_ns = 0u64;
     let mut at_rest = false;

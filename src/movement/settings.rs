@@ -1,13 +1,14 @@
 //! Movement settings: the quasi-static tooth mobility model, the collision response and their
 //! parameters (RON-serialisable).
 
-use bevy::prelude::Resource;
+use std::path::Path;
+
 use serde::{Deserialize, Serialize};
 
+use super::MovementError;
+
 /// What happens when a moving tooth meets another.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Response {
     /// The paper's: the moving tooth stops at the first contact and passes part of its load to the
@@ -23,6 +24,9 @@ pub enum Response {
 }
 
 impl Response {
+    /// Every response.
+    pub const ALL: [Response; 3] = [Response::Block, Response::Impulse, Response::Ipr];
+
     /// Lower-case name.
     pub fn name(self) -> &'static str {
         match self {
@@ -33,7 +37,13 @@ impl Response {
     }
 }
 
-/// Parameters of tooth movement.
+impl std::fmt::Display for Response {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Parameters of tooth movement (with feature `ecs`, also the movement plugin's resource).
 ///
 /// Teeth in the periodontal ligament are overdamped: a tooth's velocity follows its net load, not
 /// its history. Above a threshold, velocity = mobility × (|load| − threshold) along the load; below
@@ -42,7 +52,8 @@ impl Response {
 /// closes in under 1,000 steps; the threshold (0.5 N) and the passed fraction (1/2) let a pushed
 /// neighbour move under a 1.5 N load but not the neighbour after it, the paper's observation that
 /// the push dies out along the arch.
-#[derive(Resource, Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "ecs", derive(bevy::prelude::Resource))]
 #[serde(default, deny_unknown_fields)]
 pub struct MovementSettings {
     /// Simulated seconds per step.
@@ -86,38 +97,50 @@ impl Default for MovementSettings {
 }
 
 impl MovementSettings {
-    /// Reads settings from a RON file; errors name the file, line and column.
-    pub fn load(path: &std::path::Path) -> anyhow::Result<Self> {
-        let name = path.display();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("{name}: cannot read movement settings: {e}"))?;
+    /// Reads settings from a RON file (missing fields keep their defaults).
+    ///
+    /// # Errors
+    /// [`MovementError::SettingsUnreadable`], or [`MovementError::SettingsInvalid`] naming the
+    /// file, line and column of a syntax error, an unknown field or a value out of range.
+    pub fn load(path: &Path) -> Result<Self, MovementError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| MovementError::SettingsUnreadable {
+                path: path.to_owned(),
+                message: e.to_string(),
+            })?;
         let s: Self = ron::Options::default().from_str(&text).map_err(|e| {
-            anyhow::anyhow!(
-                "{name}:{}:{}: {}",
-                e.span.start.line,
-                e.span.start.col,
-                e.code
-            )
+            MovementError::SettingsInvalid {
+                path: path.to_owned(),
+                line: e.span.start.line,
+                column: e.span.start.col,
+                message: e.code.to_string(),
+            }
         })?;
-        if let Some((field, e)) = s.invalid_field() {
+        if let Err(e) = s.validate() {
+            let MovementError::Setting { field, .. } = e else {
+                return Err(e);
+            };
             // Point at the offending field.
             let (line, column) = text
                 .lines()
                 .enumerate()
                 .find_map(|(i, l)| l.find(field).map(|c| (i + 1, c + 1)))
                 .unwrap_or((1, 1));
-            anyhow::bail!("{name}:{line}:{column}: {e}");
+            return Err(MovementError::SettingsInvalid {
+                path: path.to_owned(),
+                line,
+                column,
+                message: e.to_string(),
+            });
         }
         Ok(s)
     }
 
-    /// Checks that every parameter is finite and in range; the message names the field.
-    pub fn validate(&self) -> Result<(), String> {
-        self.invalid_field().map_or(Ok(()), |(_, e)| Err(e))
-    }
-
-    /// The first parameter out of range, and the message naming it.
-    fn invalid_field(&self) -> Option<(&'static str, String)> {
+    /// Checks that every parameter is finite and in range.
+    ///
+    /// # Errors
+    /// [`MovementError::Setting`] naming the first parameter out of range.
+    pub fn validate(&self) -> Result<(), MovementError> {
         let checks: [(&'static str, f32, f32, f32); 9] = [
             ("step_s", self.step_s, 1e-6, 10.0),
             (
@@ -139,15 +162,17 @@ impl MovementSettings {
             ("density_kg_per_mm3", self.density_kg_per_mm3, 1e-9, 1e-3),
             ("ipr_limit_mm", self.ipr_limit_mm, 0.0, 5.0),
         ];
-        for (name, v, lo, hi) in checks {
-            if !v.is_finite() || v < lo || v > hi {
-                return Some((
-                    name,
-                    format!("movement setting {name} must be in {lo}–{hi}, got {v}"),
-                ));
+        for (field, value, min, max) in checks {
+            if !value.is_finite() || value < min || value > max {
+                return Err(MovementError::Setting {
+                    field,
+                    value,
+                    min,
+                    max,
+                });
             }
         }
-        None
+        Ok(())
     }
 }
 
@@ -162,12 +187,22 @@ mod tests {
             restitution: f32::NAN,
             ..Default::default()
         };
-        assert!(bad.validate().unwrap_err().contains("restitution"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("restitution")
+        );
         let bad = MovementSettings {
             passed_fraction: 1.5,
             ..Default::default()
         };
-        assert!(bad.validate().unwrap_err().contains("passed_fraction"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("passed_fraction")
+        );
     }
 
     #[test]

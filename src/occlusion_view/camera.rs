@@ -25,7 +25,7 @@ impl Default for OrbitCamera {
 }
 
 /// The standard clinical views.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum CameraPreset {
     /// From the front, teeth in occlusion.
     #[default]
@@ -41,6 +41,26 @@ pub enum CameraPreset {
 }
 
 impl CameraPreset {
+    /// Every view, in key order (1–5).
+    pub const ALL: [CameraPreset; 5] = [
+        CameraPreset::Frontal,
+        CameraPreset::Right,
+        CameraPreset::Left,
+        CameraPreset::Maxillary,
+        CameraPreset::Mandibular,
+    ];
+
+    /// The view's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            CameraPreset::Frontal => "frontal",
+            CameraPreset::Right => "right",
+            CameraPreset::Left => "left",
+            CameraPreset::Maxillary => "maxillary",
+            CameraPreset::Mandibular => "mandibular",
+        }
+    }
+
     /// The orbit of this view.
     pub fn orbit(self) -> OrbitCamera {
         let (yaw, pitch) = match self {
@@ -76,11 +96,18 @@ impl CameraPreset {
     }
 }
 
+impl std::fmt::Display for CameraPreset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The view the camera starts in.
 #[derive(Resource, Clone, Copy, Debug)]
 pub(super) struct InitialView(pub CameraPreset);
 
-pub(super) fn spawn_camera_and_lights(mut commands: Commands, initial: Res<InitialView>) {
+/// The orbit camera, in the initial view.
+pub(super) fn spawn_orbit_camera(mut commands: Commands, initial: Res<InitialView>) {
     let orbit = initial.0.orbit();
     commands.spawn((
         Name::new("orbit camera"),
@@ -88,6 +115,10 @@ pub(super) fn spawn_camera_and_lights(mut commands: Commands, initial: Res<Initi
         CameraPreset::transform(&orbit),
         orbit,
     ));
+}
+
+/// A key light from the upper front right and a fill light from below.
+pub(super) fn spawn_lights(mut commands: Commands) {
     commands.spawn((
         Name::new("key light"),
         DirectionalLight {

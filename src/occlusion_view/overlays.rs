@@ -6,6 +6,7 @@ use std::str::FromStr;
 
 use bevy::prelude::*;
 
+use super::ViewError;
 use crate::{
     collision::{CollisionSettings, Contacts, Method, ToothCollider},
     geometry::Pose,
@@ -61,12 +62,12 @@ impl Roots {
 }
 
 impl FromStr for Roots {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = ViewError;
+    fn from_str(s: &str) -> Result<Self, ViewError> {
         Roots::ALL
             .into_iter()
             .find(|r| r.name() == s)
-            .ok_or_else(|| format!("unknown root style '{s}': use solid, translucent or hidden"))
+            .ok_or_else(|| ViewError::UnknownRoots(s.to_owned()))
     }
 }
 
@@ -85,17 +86,15 @@ pub enum Overlay {
 }
 
 impl FromStr for Overlay {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = ViewError;
+    fn from_str(s: &str) -> Result<Self, ViewError> {
         match s {
             "contacts" => Ok(Overlay::Contacts),
             "occlusion-map" => Ok(Overlay::OcclusionMap),
             "circles" => Ok(Overlay::Circles),
             _ => match s.strip_prefix("spheres:").map(str::parse::<u32>) {
                 Some(Ok(level)) if level <= 6 => Ok(Overlay::Spheres(level)),
-                _ => Err(format!(
-                    "unknown overlay '{s}': use spheres:LEVEL (0–6), contacts, occlusion-map or circles"
-                )),
+                _ => Err(ViewError::UnknownOverlay(s.to_owned())),
             },
         }
     }
@@ -290,7 +289,13 @@ mod tests {
         );
         assert_eq!("spheres:3".parse::<Overlay>(), Ok(Overlay::Spheres(3)));
         assert!("spheres:x".parse::<Overlay>().is_err());
-        assert!("map".parse::<Overlay>().unwrap_err().contains("map"));
+        assert!(
+            "map"
+                .parse::<Overlay>()
+                .unwrap_err()
+                .to_string()
+                .contains("map")
+        );
         let o = Overlays::default()
             .with(Overlay::Spheres(2))
             .with(Overlay::Contacts);
@@ -306,6 +311,12 @@ mod tests {
         for r in Roots::ALL {
             assert_eq!(r.name().parse::<Roots>(), Ok(r));
         }
-        assert!("glass".parse::<Roots>().unwrap_err().contains("glass"));
+        assert!(
+            "glass"
+                .parse::<Roots>()
+                .unwrap_err()
+                .to_string()
+                .contains("glass")
+        );
     }
 }

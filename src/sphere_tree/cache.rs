@@ -13,10 +13,12 @@ use std::path::{Path, PathBuf};
 use super::{
     build::{TreeBuildError, TreeSettings},
     coverage::{DEFAULT_SPLIT_DEPTH, check_coverage},
-    report::write_atomic,
     tree::SphereTree,
 };
-use crate::geometry::{TriMesh, TriangleBvh};
+use crate::{
+    geometry::{TriMesh, TriangleBvh},
+    io::{OutputError, write_atomic},
+};
 
 /// Changes whenever a builder's output changes for the same mesh and settings.
 pub const BUILDER_VERSION: u32 = 13;
@@ -122,18 +124,27 @@ impl TreeCache {
     }
 
     /// Stores a tree (atomically).
+    ///
+    /// # Errors
+    /// The cache folder cannot be created or the file written.
     pub fn store(
         &self,
         mesh: &TriMesh,
         settings: &TreeSettings,
         tree: &SphereTree,
-    ) -> std::io::Result<()> {
-        std::fs::create_dir_all(&self.dir)?;
-        write_atomic(&self.path(mesh, settings), &tree.to_sph())
+    ) -> Result<(), OutputError> {
+        std::fs::create_dir_all(&self.dir).map_err(|source| OutputError::CreateFolder {
+            path: self.dir.clone(),
+            source,
+        })?;
+        write_atomic(&self.path(mesh, settings), tree.to_sph())
     }
 
-    /// The cached tree, or a new one (stored for next time; a failure to store is reported to the
-    /// log, not to the caller, since the tree itself is fine).
+    /// The cached tree, or a new one (stored for next time; a failure to store is a warning in the
+    /// log (`tracing`, which Bevy's log shows), not an error, since the tree itself is fine).
+    ///
+    /// # Errors
+    /// The settings are invalid ([`TreeSettings::validate`]).
     pub fn load_or_build(
         &self,
         settings: &TreeSettings,
@@ -146,10 +157,7 @@ impl TreeCache {
         }
         let tree = settings.build(mesh, bvh)?;
         if let Err(e) = self.store(mesh, settings, &tree) {
-            bevy::log::warn!(
-                "could not store a sphere tree in {}: {e}",
-                self.dir.display()
-            );
+            tracing::warn!("could not store a sphere tree in the cache: {e}");
         }
         Ok((tree, TreeSource::Built))
     }

@@ -15,26 +15,29 @@
 //! false negatives against the exact mesh.
 //!
 //! Builders: [`octree`] (Hubbard 1993) and [`medial`] (ours: medial-axis spheres chosen by a set
-//! cover of the outside volume). Files: [`sph`] reads and writes Bradshaw's format; [`cache`] keeps
-//! built trees on disk. Fit: [`metrics`]. ECS: [`SphereTreePlugin`] builds trees in the background.
-//! Reports: [`report`] (the `orthosim trees` command).
+//! cover of the outside volume). Files: [`sph`] reads and writes Bradshaw's format; `cache` keeps
+//! built trees on disk. Fit: [`metrics`]. ECS (feature `ecs`): `SphereTreePlugin` builds trees in
+//! the background. Reports: `report` (the `orthosim trees` command).
 
-pub mod build;
-pub mod cache;
+mod build;
+mod cache;
 pub mod coverage;
 pub mod medial;
 pub mod metrics;
 pub mod octree;
-pub mod plugin;
-pub mod report;
+#[cfg(feature = "ecs")]
+mod plugin;
+mod report;
 pub mod sph;
-pub mod tree;
+mod tree;
 
-pub use build::{TreeMethod, TreeSettings};
-pub use cache::{TreeCache, TreeSource};
+pub use build::{MAX_DEPTH, TreeBuildError, TreeMethod, TreeSettings};
+pub use cache::{BUILDER_VERSION, TreeCache, TreeSource};
 pub use coverage::{Coverage, check_coverage};
+#[cfg(feature = "ecs")]
 pub use plugin::{
     SphereTreeCache, SphereTreePlugin, SphereTreeProgress, SphereTreeSettings, SphereTreeSystems,
     ToothSphereTree,
 };
+pub use report::{ToothTreeReport, TreeSummary, TreesReport, trees_report};
 pub use tree::SphereTree;

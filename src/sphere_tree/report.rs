@@ -1,6 +1,6 @@
 //! The `orthosim trees` report: a tree per tooth, its build time and fit.
 
-use std::{path::Path, time::Instant};
+use std::time::Instant;
 
 use serde::Serialize;
 
@@ -173,40 +173,4 @@ pub fn trees_report(
         },
         trees,
     ))
-}
-
-/// Refuses to write `output` over one of `inputs` (compared as canonical paths, so relative paths
-/// and links count): outputs never replace the files a command reads.
-pub fn refuse_overwriting(output: &Path, inputs: &[&Path]) -> Result<(), String> {
-    let Ok(out) = std::fs::canonicalize(output) else {
-        return Ok(());
-    };
-    if inputs
-        .iter()
-        .any(|i| std::fs::canonicalize(i).is_ok_and(|i| i == out))
-    {
-        return Err(format!(
-            "{}: refusing to overwrite a file this command reads",
-            output.display()
-        ));
-    }
-    Ok(())
-}
-
-/// Writes `text` to `path` atomically: a temporary file beside it, then a rename, so a reader never
-/// sees half a file.
-pub fn write_atomic(path: &Path, text: &str) -> std::io::Result<()> {
-    write_atomic_bytes(path, text.as_bytes())
-}
-
-/// [`write_atomic`] for bytes.
-pub fn write_atomic_bytes(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let name = path
-        .file_name()
-        .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
 }

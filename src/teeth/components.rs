@@ -1,4 +1,5 @@
-//! ECS components of a tooth entity.
+//! ECS components of a tooth entity (feature `ecs`); its [`Load`] is a core type that is a
+//! component too.
 
 use std::sync::Arc;
 
@@ -7,6 +8,7 @@ use bevy::prelude::*;
 use super::{
     case::WireModel,
     fdi::{Fdi, ToothKind},
+    load::Load,
     tooth_shape::ToothGeometry,
 };
 
@@ -24,40 +26,6 @@ pub struct Tooth {
 /// The tooth's shared geometry (mesh, hierarchy, frame); teeth of one type share one.
 #[derive(Component, Clone, Debug, Deref)]
 pub struct ToothShape(pub Arc<ToothGeometry>);
-
-/// Force (N) and torque (N·mm) on a tooth, world frame.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Reflect)]
-pub struct Load {
-    /// Force (N).
-    pub force: Vec3,
-    /// Torque (N·mm).
-    pub torque: Vec3,
-}
-
-impl Load {
-    /// Refuses loads that cannot be simulated: NaN or infinite components, or magnitudes beyond
-    /// what a case file accepts ([`MAX_FORCE_N`](super::case::MAX_FORCE_N),
-    /// [`MAX_TORQUE_NMM`](super::case::MAX_TORQUE_NMM)).
-    pub fn check(&self) -> Result<(), String> {
-        if !(self.force.is_finite() && self.torque.is_finite()) {
-            return Err("a load with NaN or infinite components was refused".into());
-        }
-        let (f, t) = (self.force.length(), self.torque.length());
-        if f > super::case::MAX_FORCE_N {
-            return Err(format!(
-                "a force of {f:.1} N was refused: at most {} N",
-                super::case::MAX_FORCE_N
-            ));
-        }
-        if t > super::case::MAX_TORQUE_NMM {
-            return Err(format!(
-                "a torque of {t:.1} N·mm was refused: at most {} N·mm",
-                super::case::MAX_TORQUE_NMM
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// The archwire model that decides how the tooth responds to its load.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref)]

@@ -1,26 +1,33 @@
-//! Teeth: FDI numbers, the anatomy table, procedural tooth meshes, arch forms, patient cases and
-//! the [`TeethModelPlugin`] that spawns tooth entities.
+//! Teeth: FDI numbers, the anatomy table, procedural tooth meshes, arch forms, patient cases, mesh
+//! import, and (feature `ecs`) the `TeethModelPlugin` that spawns tooth entities.
 //!
 //! Engine-free parts (`fdi`, `anatomy`, `shape`, `frame`, `tooth_shape`, `arch`, `case`,
-//! `dentition`) need no `World`; `components` and `plugin` are the ECS layer.
+//! `dentition`, `load`, `import`) need no `World`; `components` and `plugin` are the ECS layer.
 
 pub mod anatomy;
 pub mod arch;
 pub mod case;
-pub mod components;
-pub mod dentition;
-pub mod fdi;
-pub mod frame;
+#[cfg(feature = "ecs")]
+mod components;
+mod dentition;
+mod fdi;
+mod frame;
 pub mod import;
+mod load;
 mod memo;
-pub mod plugin;
+#[cfg(feature = "ecs")]
+mod plugin;
 pub mod shape;
-pub mod tooth_shape;
+mod tooth_shape;
 
 pub use case::{Case, CaseError, LoadedCase, WireModel};
-pub use components::{Extracted, Load, LoadGroup, Tooth, ToothShape, Wire};
-pub use dentition::{Dentition, PlacedTooth};
-pub use fdi::{Arch, Fdi, Side, ToothKind};
+#[cfg(feature = "ecs")]
+pub use components::{Extracted, LoadGroup, Tooth, ToothShape, Wire};
+pub use dentition::{Dentition, GroupLoad, PlacedTooth};
+pub use fdi::{Arch, Fdi, InvalidFdi, Side, ToothKind};
+pub use frame::{CentreParameters, ToothFrame};
+pub use load::{Load, LoadError};
+#[cfg(feature = "ecs")]
 pub use plugin::{
     ActiveCase, CaseLoadFailed, CaseLoaded, LoadCase, TeethModelPlugin, TeethModelSystems,
 };

@@ -15,8 +15,9 @@ use bevy::{
 
 use super::{
     case::{Case, CaseError},
-    components::{Extracted, Load, LoadGroup, Tooth, ToothShape, Wire},
+    components::{Extracted, LoadGroup, Tooth, ToothShape, Wire},
     dentition::Dentition,
+    load::Load,
 };
 
 /// Ask for a case to be loaded: a built-in name (`normal`, `case1`…) or a path to a .ron file.

@@ -604,3 +604,71 @@ fn outputs_never_replace_the_case_file_being_read() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A case's name becomes a file name on export: names of 1–120 characters without control
+/// characters are accepted, others refused at the name's position in the file.
+#[test]
+fn case_names_are_short_and_printable() {
+    let dir = fresh_dir("names");
+    for (name, ok) in [
+        ("a".to_owned(), true),
+        ("é".repeat(120), true),
+        (String::new(), false),
+        ("n".repeat(121), false),
+        ("n".repeat(300_000), false),
+        ("tab\there".to_owned(), false),
+    ] {
+        let case = dir.join("named.ron");
+        let text =
+            format!("// a case\nCase(\n    name: \"{name}\",\n    teeth: Only([11, 21]),\n)\n");
+        std::fs::write(&case, text).unwrap();
+        let out = orthosim(&["inspect", "--case", case.to_str().unwrap(), "--json"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.success(), ok, "{} chars: {err}", name.len());
+        if !ok {
+            assert_eq!(err.trim().lines().count(), 1, "{err}");
+            assert!(err.contains("named.ron:3:5:"), "{err}");
+            assert!(err.contains("case name"), "{err}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `export-case` checks every output before it writes any: a refused export leaves the folder as
+/// it was, and a folder it would have created is not created.
+#[test]
+fn a_refused_export_writes_nothing() {
+    let dir = fresh_dir("all-or-nothing");
+    // The case file sits where the export would write its 21.stl: refused before anything is written.
+    let case = dir.join("21.stl");
+    std::fs::write(&case, "Case(name: \"x\", teeth: Only([11, 21]))\n").unwrap();
+    // A case file named with an extension other than .ron still loads: it is named in full.
+    let out = orthosim(&[
+        "export-case",
+        "--case",
+        case.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("21.stl: refusing to overwrite"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert_eq!(left, ["21.stl"], "nothing written beside the case");
+    // An output folder that does not exist is not created by a refused export.
+    let fresh = dir.join("new");
+    let long = "d".repeat(300);
+    let out = orthosim(&[
+        "export-case",
+        "--case",
+        case.to_str().unwrap(),
+        "--out",
+        fresh.join(&long).to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(!fresh.exists(), "a refused export created its folder");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,12 +4,9 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use orthosim::{
-    collision::{
-        Body, Circle, CollisionShape, Method, Motion,
-        bench::{self, Rng},
-        query,
-    },
+    collision::{Body, Circle, CollisionShape, Method, Motion, query},
     geometry::Pose,
+    internals::Rng,
     sphere_tree::{TreeMethod, TreeSettings},
     teeth::{Case, Dentition, Fdi},
 };
@@ -60,7 +57,7 @@ fn teeth_branching(
 /// A random step of `t` near its rest pose, heading roughly towards `target` (the bench's
 /// generator: 0.01–5 mm, up to ±15°).
 fn random_motion(rng: &mut Rng, t: &TestTooth, target: Vec3) -> Motion {
-    bench::random_motion(rng, &t.rest, target)
+    orthosim::internals::random_motion(rng, &t.rest, target)
 }
 
 fn intersects(a: &TestTooth, pa: &Pose, b: &TestTooth, pb: &Pose) -> bool {

@@ -10,7 +10,7 @@ use orthosim::{
 
 /// A headless app with the simulation plugins and a manual clock.
 pub(crate) fn create_app() -> App {
-    app_with(OrthoSimPlugins.build())
+    app_with(OrthoSimPlugins::default().build())
 }
 
 /// A headless app with the given plugins and a manual clock.
@@ -214,7 +214,7 @@ fn a_moving_tooth_reports_contacts_and_nothing_runs_when_nothing_moves() {
     // Motions are set by hand here: the collision plugin alone, without the movement plugin
     // (which would write every tooth's motion each step).
     let mut app = app_with(
-        OrthoSimPlugins
+        OrthoSimPlugins::default()
             .build()
             .disable::<orthosim::movement::MovementPlugin>(),
     );

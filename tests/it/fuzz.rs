@@ -64,7 +64,8 @@ fn mutate(source: &[u8], muts: &[Mutation]) -> Vec<u8> {
     s
 }
 
-fn one_line(e: &str) {
+fn one_line(e: &impl std::fmt::Display) {
+    let e = e.to_string();
     assert!(!e.is_empty() && !e.contains('\n'), "not one line: {e:?}");
 }
 

@@ -36,7 +36,10 @@ fn world_tooth(d: &Dentition, n: u8) -> (TriMesh, ArchCurve, Fdi) {
     )
 }
 
-fn import(mesh: &TriMesh, n: u8) -> Result<orthosim::teeth::import::ImportedTooth, String> {
+fn import(
+    mesh: &TriMesh,
+    n: u8,
+) -> Result<orthosim::teeth::import::ImportedTooth, orthosim::teeth::import::ImportError> {
     let d = normal();
     let (_, curve, fdi) = world_tooth(&d, n);
     import_mesh(mesh, fdi, &curve, &RepairLimits::default())
@@ -112,7 +115,7 @@ fn an_exported_case_reads_back_with_the_same_geometry() {
         assert!((gap(&d) - gap(&back)).abs() < 1e-3, "{a}-{b}");
     }
     // The exported case is not overwritten by exporting it onto itself.
-    let again = export_case(&back, &dir).unwrap_err();
+    let again = export_case(&back, &dir).unwrap_err().to_string();
     assert!(again.contains("refusing"), "{again}");
     // Nor are its mesh files, read by a case kept elsewhere; nothing is written then.
     let text = std::fs::read_to_string(&report.case_file).unwrap();
@@ -122,7 +125,7 @@ fn an_exported_case_reads_back_with_the_same_geometry() {
     std::fs::create_dir_all(dir.join("sub")).unwrap();
     std::fs::write(dir.join("sub/moved.ron"), moved).unwrap();
     let elsewhere = Dentition::build(Case::load(&dir.join("sub/moved.ron")).unwrap()).unwrap();
-    let again = export_case(&elsewhere, &dir).unwrap_err();
+    let again = export_case(&elsewhere, &dir).unwrap_err().to_string();
     assert!(
         again.contains("refusing") && again.contains(".stl"),
         "{again}"
@@ -299,7 +302,7 @@ fn broken_meshes_are_refused_with_the_reason() {
     let d = normal();
     let (mesh, _, _) = world_tooth(&d, 36);
     let refuse = |m: &TriMesh, what: &str| {
-        let e = import(m, 36).unwrap_err();
+        let e = import(m, 36).unwrap_err().to_string();
         assert!(e.contains(what), "expected '{what}' in: {e}");
     };
     refuse(&TriMesh::default(), "empty");

@@ -13,8 +13,8 @@ use bevy::prelude::*;
 use orthosim::{
     collision::{Method, collision_shapes},
     movement::{
-        MovementSettings, MovementStatus, Response, Simulation, SimulationState,
-        report::{CaseRun, max_penetration, run_case},
+        CaseRun, MovementSettings, MovementStatus, Response, Simulation, SimulationState,
+        max_penetration, run_case,
     },
     prelude::*,
     sphere_tree::{TreeCache, TreeMethod, TreeSettings},
@@ -573,13 +573,18 @@ fn teeth_are_extracted_and_restored_while_the_case_runs() {
     without_18.teeth.retain(|t| t.fdi != fdi(18));
     let absent = sim
         .with_extraction(&without_18, fdi(18), true, None)
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(absent.contains("not in the case"), "{absent}");
-    let again = sim.with_extraction(&d, fdi(14), true, None).unwrap_err();
+    let again = sim
+        .with_extraction(&d, fdi(14), true, None)
+        .unwrap_err()
+        .to_string();
     assert!(again.contains("already extracted"), "{again}");
     let present = sim
         .with_extraction(&d, fdi(15), false, shape_of(15))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(present.contains("already in place"), "{present}");
     assert!(sim.with_extraction(&d, fdi(14), false, None).is_err());
 
@@ -612,7 +617,8 @@ fn teeth_are_extracted_and_restored_while_the_case_runs() {
     assert!(sim.teeth[i15].displacement_mm() >= 1.0);
     let refused = sim
         .with_extraction(&d, fdi(14), false, shape_14)
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(refused.contains("15 has moved into its place"), "{refused}");
 }
 

@@ -2,11 +2,11 @@
 
 use glam::{Quat, Vec3};
 use orthosim::{
-    collision::bench::Rng,
     geometry::{
         MassProperties, Pose, closest_points_triangle_triangle, mesh_separation,
         triangles_intersect,
     },
+    internals::Rng,
     teeth::{Case, Dentition, PlacedTooth},
 };
 use parry3d::{

@@ -17,13 +17,7 @@ use glam::DVec3;
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{Signed, Zero};
-use orthosim::{
-    collision::narrow_phase::{
-        continuous::{first_contact, may_meet},
-        lanes::{GROW, f32_slack},
-    },
-    geometry::interval::Interval,
-};
+use orthosim::internals::{GROW, Interval, f32_slack, first_contact, may_meet};
 use proptest::prelude::*;
 
 fn q(x: f64) -> BigRational {

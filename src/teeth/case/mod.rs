@@ -17,7 +17,7 @@ pub use parts::{
 };
 pub use values::{Finite, NonNegative, ToothList, ToothMap};
 
-use super::{fdi::Fdi, shape::ToothResolution};
+use super::{fdi::Fdi, import::ImportError, shape::ToothResolution};
 
 /// The built-in cases: name and RON source (embedded in the binary).
 pub const BUILTIN_CASES: [(&str, &str); 4] = [
@@ -26,6 +26,9 @@ pub const BUILTIN_CASES: [(&str, &str); 4] = [
     ("case2", include_str!("../../../assets/cases/case2.ron")),
     ("case3", include_str!("../../../assets/cases/case3.ron")),
 ];
+
+/// Longest case name (characters): the name becomes a file name when a case is exported.
+pub const MAX_NAME_CHARS: usize = 120;
 
 /// Largest force accepted on one load (N); orthodontic forces are 0.1–5 N.
 pub const MAX_FORCE_N: f32 = 50.0;
@@ -74,7 +77,7 @@ pub enum CaseError {
         /// The case file that names it.
         case: String,
         /// What is wrong, and where in the mesh.
-        message: String,
+        message: ImportError,
     },
     /// The name is neither a built-in case nor an existing file.
     #[error(
@@ -87,7 +90,7 @@ pub enum CaseError {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
-    /// Short name.
+    /// Short name: 1–[`MAX_NAME_CHARS`] characters, no control characters.
     pub name: String,
     /// What the case shows.
     #[serde(default)]
@@ -147,6 +150,24 @@ impl Case {
     }
 
     /// Loads a built-in case by name, or a .ron file by path.
+    ///
+    /// # Errors
+    /// [`CaseError::Unknown`] for a name that is neither; [`CaseError::Io`] for a file that cannot
+    /// be read; [`CaseError::Invalid`] with the file, line and column of the first problem (syntax,
+    /// unknown field or tooth, a number out of range, a load on an absent tooth…).
+    ///
+    /// # Example
+    /// ```
+    /// use orthosim::teeth::{Case, Dentition};
+    /// let loaded = Case::resolve("case1")?;
+    /// assert_eq!(loaded.origin, "builtin:case1");
+    /// let d = Dentition::build(loaded)?;
+    /// assert_eq!(d.visible().count(), 28, "first premolars extracted");
+    ///
+    /// let e = Case::parse("Case(name: \"x\", extracted: [19])", "mine.ron").unwrap_err();
+    /// assert!(e.to_string().starts_with("mine.ron:1:"), "{e}");
+    /// # Ok::<(), orthosim::teeth::CaseError>(())
+    /// ```
     pub fn resolve(name_or_path: &str) -> Result<LoadedCase, CaseError> {
         if let Some((name, src)) = BUILTIN_CASES.iter().find(|(n, _)| *n == name_or_path) {
             return Self::parse(src, &format!("builtin:{name}"));
@@ -257,6 +278,24 @@ impl Case {
 
     /// Cross-field checks: (field, offending token, message).
     fn check(&self) -> Result<(), (&'static str, Option<String>, String)> {
+        let length = self.name.chars().count();
+        if !(1..=MAX_NAME_CHARS).contains(&length) {
+            return Err((
+                "name",
+                None,
+                format!("the case name must be 1–{MAX_NAME_CHARS} characters, got {length}"),
+            ));
+        }
+        if let Some(c) = self.name.chars().find(|c| c.is_control()) {
+            return Err((
+                "name",
+                None,
+                format!(
+                    "the case name holds the control character U+{:04X}",
+                    u32::from(c)
+                ),
+            ));
+        }
         let present = self.present();
         if let Some(r) = self.resolution
             && !(20..=200_000).contains(&r)

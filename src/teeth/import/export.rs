@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::{MeshTransform, ToothMeshFile, Units, write_stl};
 use crate::{
-    sphere_tree::report::{refuse_overwriting, write_atomic_bytes},
+    io::{OutputError, OutputSet},
     teeth::{
         Dentition,
         case::{Case, ToothMap},
@@ -26,11 +26,14 @@ pub struct ExportReport {
     pub triangles: usize,
 }
 
-/// Writes the teeth of `d` to `dir` (created if needed) as `NN.stl` and the case as `NAME.ron`.
-/// Files are written atomically; the case file `d` was read from and its mesh files are never
-/// replaced.
-pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+/// Writes the teeth of `d` to `dir` (created if needed) as `NN.stl` and the case as `NAME.ron`,
+/// all or nothing: every output is checked (name and path lengths, never the case file `d` was
+/// read from or one of its mesh files) before any is written, each is written to a temporary file
+/// and all are moved into place at the end; on failure nothing is left behind.
+///
+/// # Errors
+/// The first output that cannot or must not be written ([`OutputError`]).
+pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, OutputError> {
     let source = Path::new(&d.case.origin);
     let mut case: Case = d.case.case.clone();
     let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
@@ -43,31 +46,33 @@ pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, String> {
             .map(|m| Case::mesh_path(&d.case.origin, &m.file)),
     );
     let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
-    refuse_overwriting(&case_file, &inputs)?;
-    for t in &d.teeth {
-        refuse_overwriting(&dir.join(format!("{}.stl", t.fdi.number())), &inputs)?;
-    }
-    let mut meshes = Vec::new();
+    let meshes: Vec<PathBuf> = d
+        .teeth
+        .iter()
+        .map(|t| dir.join(format!("{}.stl", t.fdi.number())))
+        .collect();
+    let mut outputs = meshes.clone();
+    outputs.push(case_file.clone());
+    let mut set = OutputSet::new(dir, outputs, &inputs)?;
     let mut files = ToothMap::default();
     let mut triangles = 0;
-    for t in &d.teeth {
-        let name = format!("{}.stl", t.fdi.number());
-        let path = dir.join(&name);
+    for (t, path) in d.teeth.iter().zip(&meshes) {
         let world = t.geometry.mesh.map_vertices(|v| t.pose.transform_point(v));
         let mut bytes = Vec::new();
-        write_stl(&world, &mut bytes).map_err(|e| format!("{}: {e}", path.display()))?;
-        write_atomic_bytes(&path, &bytes)
-            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        write_stl(&world, &mut bytes).map_err(|source| OutputError::Write {
+            path: path.clone(),
+            source,
+        })?;
+        set.write(path, bytes)?;
         triangles += world.triangles.len();
         files.0.insert(
             t.fdi,
             ToothMeshFile {
-                file: name,
+                file: format!("{}.stl", t.fdi.number()),
                 units: Units::Millimetres,
                 transform: MeshTransform::default(),
             },
         );
-        meshes.push(path);
     }
     // The meshes stand where the case placed the teeth: offsets and the bite opening are in them.
     case.meshes = files;
@@ -75,14 +80,17 @@ pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, String> {
     case.bite_opening_mm = Default::default();
     let text =
         ron::ser::to_string_pretty(&case, ron::ser::PrettyConfig::default().struct_names(true))
-            .map_err(|e| format!("cannot write the case: {e}"))?;
+            .map_err(|e| OutputError::Write {
+                path: case_file.clone(),
+                source: std::io::Error::other(e),
+            })?;
     let header = format!(
         "// Exported by `orthosim export-case` from {}: one STL per tooth (mm, orthosim's frame,\n\
          // where the case placed it), so offsets and the bite opening are part of the meshes.\n",
         d.case.origin
     );
-    write_atomic_bytes(&case_file, format!("{header}{text}\n").as_bytes())
-        .map_err(|e| format!("{}: cannot write: {e}", case_file.display()))?;
+    set.write(&case_file, format!("{header}{text}\n"))?;
+    set.commit()?;
     Ok(ExportReport {
         case_file,
         meshes,

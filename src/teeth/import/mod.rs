@@ -22,8 +22,9 @@
 //! So loads, wire models, constraints and the analysis work on imported teeth as on procedural
 //! ones; the tooth stands exactly where the scan has it (its pose maps the local mesh back).
 
-pub mod export;
-pub mod read;
+mod error;
+mod export;
+mod read;
 pub mod repair;
 pub mod root;
 
@@ -41,9 +42,9 @@ use super::{
 };
 use crate::geometry::{MassProperties, MeshError, Pose, TriMesh};
 
+pub use error::{ImportError, Near, PlyProblem};
 pub use export::{ExportReport, export_case};
 pub use read::{MeshFormat, read_mesh, write_stl};
-use repair::near;
 pub use repair::{RepairLimits, Repairs};
 
 /// Units of a mesh file.
@@ -130,15 +131,17 @@ pub struct ImportedTooth {
 }
 
 /// Reads, repairs and frames the mesh of tooth `fdi` from `path`; `curve` is the arch curve of
-/// the tooth's arch (for its buccal direction). Errors say what is wrong and where, without the
-/// path.
+/// the tooth's arch (for its buccal direction).
+///
+/// # Errors
+/// What is wrong and where, without the path ([`ImportError`]).
 pub fn import_tooth(
     path: &Path,
     spec: &ToothMeshFile,
     fdi: Fdi,
     curve: &ArchCurve,
     limits: &RepairLimits,
-) -> Result<ImportedTooth, String> {
+) -> Result<ImportedTooth, ImportError> {
     let raw = read_mesh(path)?;
     let transform = spec.transform.pose();
     let scale = spec.units.mm();
@@ -147,21 +150,25 @@ pub fn import_tooth(
 }
 
 /// [`import_tooth`] for a mesh already read, in orthosim's frame (mm).
+///
+/// # Errors
+/// What is wrong and where ([`ImportError`]).
 pub fn import_mesh(
     world: &TriMesh,
     fdi: Fdi,
     curve: &ArchCurve,
     limits: &RepairLimits,
-) -> Result<ImportedTooth, String> {
+) -> Result<ImportedTooth, ImportError> {
     let an = anatomy(fdi.arch(), fdi.kind());
     // (Non-finite coordinates are refused by the repair, naming the vertex.)
     if !world.vertices.is_empty() && world.vertices.iter().all(|v| v.is_finite()) {
         let span = world.aabb().extent().max_element();
         if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
-            return Err(format!(
-                "the mesh spans {span:.4} mm, not a tooth's {MIN_SPAN_MM}–{MAX_SPAN_MM} mm: are \
-                 its units right (units: Millimetres, Metres or Inches)?"
-            ));
+            return Err(ImportError::Span {
+                span_mm: span,
+                min_mm: MIN_SPAN_MM,
+                max_mm: MAX_SPAN_MM,
+            });
         }
     }
     let mut repairs = Repairs::default();
@@ -175,13 +182,11 @@ pub fn import_mesh(
             // A crown's margin faces away from the occlusal surface: any other large opening is a
             // hole, not a missing root.
             if apical.dot(-occlusal_direction(fdi.arch())) < MARGIN_COS {
-                return Err(format!(
-                    "the mesh is open: an opening with a {length:.2} mm boundary {} is beyond the \
-                     {} mm closed automatically, and it does not face the root's side as a \
-                     crown's margin does",
-                    near(mesh.vertices[margin[0] as usize]),
-                    limits.max_hole_mm
-                ));
+                return Err(ImportError::OpenNotMargin {
+                    length_mm: length,
+                    at: Near(mesh.vertices[margin[0] as usize]),
+                    max_hole_mm: limits.max_hole_mm,
+                });
             }
             repairs.root_generated_margin_mm = Some(length);
             Some(centre)
@@ -192,14 +197,12 @@ pub fn import_mesh(
                 .map(|l| (l, repair::loop_length(&mesh, l)))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .expect("several loops");
-            return Err(format!(
-                "the mesh is open: {} openings, the smallest with a {length:.2} mm boundary {}, \
-                 beyond the {} mm closed automatically (a scanned crown has one opening, at the \
-                 gum line)",
-                loops.len(),
-                near(mesh.vertices[l[0] as usize]),
-                limits.max_hole_mm
-            ));
+            return Err(ImportError::Open {
+                openings: loops.len(),
+                length_mm: length,
+                at: Near(mesh.vertices[l[0] as usize]),
+                max_hole_mm: limits.max_hole_mm,
+            });
         }
     };
     if mesh.signed_volume() < 0.0 {
@@ -221,24 +224,20 @@ pub fn import_mesh(
 }
 
 /// A mesh error with the place it is at.
-fn explain(mesh: &TriMesh, e: MeshError) -> String {
+fn explain(mesh: &TriMesh, e: MeshError) -> ImportError {
     let centre = |t: usize| {
         let [a, b, c] = mesh.triangle(t);
         (a + b + c) / 3.0
     };
     match e {
-        MeshError::SelfIntersecting { a, b } => format!(
-            "the mesh intersects itself: triangles {a} and {b} cross {}",
-            near(centre(a))
-        ),
-        MeshError::Degenerate { triangle, .. } => format!(
-            "a degenerate triangle remains after repair {}",
-            near(centre(triangle))
-        ),
-        MeshError::Inverted { volume } => {
-            format!("the mesh encloses no volume ({volume:.4} mm³): it is flat")
-        }
-        other => format!("the repaired mesh is not a closed solid: {other}"),
+        MeshError::SelfIntersecting { a, b } => ImportError::SelfIntersecting {
+            a,
+            b,
+            at: Near(centre(a)),
+        },
+        MeshError::Degenerate { triangle, .. } => ImportError::Degenerate(Near(centre(triangle))),
+        MeshError::Inverted { volume } => ImportError::Flat { volume },
+        other => ImportError::NotSolid(other),
     }
 }
 

@@ -10,6 +10,7 @@ use std::{
 
 use glam::Vec3;
 
+use super::error::{ImportError, PlyProblem};
 use crate::geometry::TriMesh;
 
 /// Mesh file formats orthosim reads.
@@ -23,9 +24,22 @@ pub enum MeshFormat {
     Ply,
 }
 
+impl std::fmt::Display for MeshFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MeshFormat::Stl => "STL",
+            MeshFormat::Obj => "OBJ",
+            MeshFormat::Ply => "PLY",
+        })
+    }
+}
+
 impl MeshFormat {
     /// The format of a file, from its extension.
-    pub fn of(path: &Path) -> Result<Self, String> {
+    ///
+    /// # Errors
+    /// [`ImportError::UnknownFormat`] for any other extension.
+    pub fn of(path: &Path) -> Result<Self, ImportError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -34,25 +48,39 @@ impl MeshFormat {
             Some("stl") => Ok(Self::Stl),
             Some("obj") => Ok(Self::Obj),
             Some("ply") => Ok(Self::Ply),
-            _ => Err("unknown mesh format: the file must end in .stl, .obj or .ply".into()),
+            _ => Err(ImportError::UnknownFormat),
         }
     }
 }
 
-/// Reads a mesh file (errors say what is wrong, on one line, without the path).
-pub fn read_mesh(path: &Path) -> Result<TriMesh, String> {
+/// Reads a mesh file.
+///
+/// # Errors
+/// What is wrong, on one line, without the path: an unknown format, an unreadable or empty file,
+/// or one that is not valid in its format (with the line, for OBJ).
+pub fn read_mesh(path: &Path) -> Result<TriMesh, ImportError> {
     let format = MeshFormat::of(path)?;
-    let file = File::open(path).map_err(|e| format!("cannot read the mesh file: {e}"))?;
+    let file = File::open(path).map_err(|e| ImportError::Unreadable(e.to_string()))?;
     let mut reader = BufReader::new(file);
     match format {
         MeshFormat::Stl => read_stl(&mut reader),
-        MeshFormat::Obj => read_obj(&mut reader).map_err(|e| match obj_bad_line(path) {
-            Some(line) => format!("{e} (line {line})"),
-            None => e,
+        MeshFormat::Obj => read_obj(&mut reader).map_err(|e| match (e, obj_bad_line(path)) {
+            (ImportError::Malformed { format, detail }, Some(line)) => ImportError::Malformed {
+                format,
+                detail: format!("{detail} (line {line})"),
+            },
+            (e, _) => e,
         }),
         MeshFormat::Ply => read_ply(&mut reader),
     }
-    .map_err(|e| one_line(&e))
+}
+
+/// The parser's message as the detail of a malformed file (on one line).
+fn malformed(format: MeshFormat, e: impl std::fmt::Display) -> ImportError {
+    ImportError::Malformed {
+        format,
+        detail: one_line(&e.to_string()),
+    }
 }
 
 /// Parsers' messages can span lines; errors are one line.
@@ -60,13 +88,12 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, String> {
-    let len = reader
-        .seek(std::io::SeekFrom::End(0))
-        .map_err(|e| e.to_string())?;
-    reader.rewind().map_err(|e| e.to_string())?;
+fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, ImportError> {
+    let unreadable = |e: std::io::Error| ImportError::Unreadable(e.to_string());
+    let len = reader.seek(std::io::SeekFrom::End(0)).map_err(unreadable)?;
+    reader.rewind().map_err(unreadable)?;
     if len == 0 {
-        return Err("the file is empty".into());
+        return Err(ImportError::EmptyFile);
     }
     let mesh = stl_io::read_stl(reader).map_err(|e| {
         // A binary file that ends early: say what its header promised.
@@ -76,12 +103,14 @@ fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, String> 
             && std::io::Read::read_exact(reader, &mut head).is_ok())
         .then(|| u32::from_le_bytes([head[80], head[81], head[82], head[83]]) as u64);
         match promised {
-            Some(n) if 84 + 50 * n != len && !head.starts_with(b"solid") => format!(
-                "not a valid STL file: as binary STL its header announces {n} triangles \
-                 ({} bytes), but the file has {len} bytes",
-                84 + 50 * n
-            ),
-            _ => format!("not a valid STL file: {e}"),
+            Some(n) if 84 + 50 * n != len && !head.starts_with(b"solid") => {
+                ImportError::StlLength {
+                    triangles: n,
+                    expected: 84 + 50 * n,
+                    bytes: len,
+                }
+            }
+            _ => malformed(MeshFormat::Stl, e),
         }
     })?;
     Ok(TriMesh::new(
@@ -96,7 +125,7 @@ fn read_stl<R: std::io::Read + Seek>(reader: &mut R) -> Result<TriMesh, String> 
     ))
 }
 
-fn read_obj<R: std::io::BufRead>(reader: &mut R) -> Result<TriMesh, String> {
+fn read_obj<R: std::io::BufRead>(reader: &mut R) -> Result<TriMesh, ImportError> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -105,7 +134,7 @@ fn read_obj<R: std::io::BufRead>(reader: &mut R) -> Result<TriMesh, String> {
     // Materials are not needed: never open .mtl files.
     let (models, _) =
         tobj::load_obj_buf(reader, &options, |_| Err(tobj::LoadError::OpenFileFailed))
-            .map_err(|e| format!("not a valid OBJ file: {e}"))?;
+            .map_err(|e| malformed(MeshFormat::Obj, e))?;
     let mut mesh = TriMesh::default();
     for model in models {
         let base = mesh.vertices.len() as u32;
@@ -148,11 +177,11 @@ fn obj_bad_line(path: &Path) -> Option<usize> {
     None
 }
 
-fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, String> {
+fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, ImportError> {
     use ply_rs_bw::{parser::Parser, ply::DefaultElement, ply::Property};
     let ply = Parser::<DefaultElement>::new()
         .read_ply(reader)
-        .map_err(|e| format!("not a valid PLY file: {e}"))?;
+        .map_err(|e| malformed(MeshFormat::Ply, e))?;
     let scalar = |p: &Property| -> Option<f64> {
         Some(match *p {
             Property::Char(v) => v as f64,
@@ -180,15 +209,14 @@ fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, String> {
     let vertices = ply
         .payload
         .get("vertex")
-        .ok_or("the PLY file has no `vertex` element")?;
+        .ok_or(ImportError::PlyContent(PlyProblem::NoElement("vertex")))?;
     let mut mesh = TriMesh::default();
     for (i, v) in vertices.iter().enumerate() {
         let mut xyz = [0.0f32; 3];
-        for (k, name) in ["x", "y", "z"].iter().enumerate() {
-            let value = v
-                .get(*name)
-                .and_then(scalar)
-                .ok_or_else(|| format!("PLY vertex {i} has no numeric `{name}`"))?;
+        for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
+            let value = v.get(name).and_then(scalar).ok_or(ImportError::PlyContent(
+                PlyProblem::NoCoordinate { vertex: i, name },
+            ))?;
             xyz[k] = value as f32;
         }
         mesh.vertices.push(Vec3::from_array(xyz));
@@ -196,18 +224,23 @@ fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, String> {
     let faces = ply
         .payload
         .get("face")
-        .ok_or("the PLY file has no `face` element")?;
+        .ok_or(ImportError::PlyContent(PlyProblem::NoElement("face")))?;
     for (i, f) in faces.iter().enumerate() {
         let indices = f
             .get("vertex_indices")
             .or_else(|| f.get("vertex_index"))
             .and_then(list)
-            .ok_or_else(|| format!("PLY face {i} has no `vertex_indices` list"))?;
+            .ok_or(ImportError::PlyContent(PlyProblem::NoIndices(i)))?;
         if indices.len() < 3 {
-            return Err(format!("PLY face {i} has {} vertices", indices.len()));
+            return Err(ImportError::PlyContent(PlyProblem::TooFewVertices {
+                face: i,
+                count: indices.len(),
+            }));
         }
-        let index =
-            |x: i64| u32::try_from(x).map_err(|_| format!("PLY face {i} has the vertex index {x}"));
+        let index = |x: i64| {
+            u32::try_from(x)
+                .map_err(|_| ImportError::PlyContent(PlyProblem::BadIndex { face: i, index: x }))
+        };
         for k in 1..indices.len() - 1 {
             mesh.triangles.push([
                 index(indices[0])?,

@@ -17,6 +17,7 @@ use std::collections::{HashMap, HashSet, VecDeque};
 use glam::{DVec3, IVec3, Vec3};
 use serde::Serialize;
 
+use super::error::{ImportError, Near};
 use crate::geometry::TriMesh;
 
 /// Limits of what is repaired rather than refused.
@@ -118,35 +119,29 @@ pub(super) struct OpenSurface {
     pub loops: Vec<Vec<u32>>,
 }
 
-/// Where something is, for messages.
-pub(super) fn near(v: Vec3) -> String {
-    format!("near ({:.3}, {:.3}, {:.3}) mm", v.x, v.y, v.z)
-}
-
 /// Checks, welds, cleans, orients and closes small holes. Large openings are returned as loops.
 pub(super) fn clean(
     mesh: &TriMesh,
     limits: &RepairLimits,
     repairs: &mut Repairs,
-) -> Result<OpenSurface, String> {
+) -> Result<OpenSurface, ImportError> {
     if mesh.vertices.is_empty() || mesh.triangles.is_empty() {
-        return Err(format!(
-            "the mesh is empty ({} vertices, {} triangles)",
-            mesh.vertices.len(),
-            mesh.triangles.len()
-        ));
+        return Err(ImportError::Empty {
+            vertices: mesh.vertices.len(),
+            triangles: mesh.triangles.len(),
+        });
     }
     if let Some(i) = mesh.vertices.iter().position(|v| !v.is_finite()) {
-        return Err(format!(
-            "vertex {i} has a non-finite coordinate (NaN or infinity)"
-        ));
+        return Err(ImportError::NonFinite(i));
     }
     let n = mesh.vertices.len();
     for (i, t) in mesh.triangles.iter().enumerate() {
         if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
-            return Err(format!(
-                "triangle {i} refers to vertex {v}, but there are only {n} vertices"
-            ));
+            return Err(ImportError::BadIndex {
+                triangle: i,
+                vertex: v,
+                vertices: n,
+            });
         }
     }
     let (vertices, triangles) = weld(mesh, limits.weld_mm, repairs);
@@ -261,7 +256,7 @@ fn undirected(a: u32, b: u32) -> (u32, u32) {
 fn edge_map(
     vertices: &[Vec3],
     triangles: &[[u32; 3]],
-) -> Result<HashMap<(u32, u32), Vec<usize>>, String> {
+) -> Result<HashMap<(u32, u32), Vec<usize>>, ImportError> {
     let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::with_capacity(triangles.len() * 2);
     for (i, t) in triangles.iter().enumerate() {
         for k in 0..3 {
@@ -275,12 +270,11 @@ fn edge_map(
     bad.sort_unstable_by_key(|(e, _)| **e);
     if let Some(((a, b), list)) = bad.first() {
         let mid = (vertices[*a as usize] + vertices[*b as usize]) / 2.0;
-        return Err(format!(
-            "the mesh is non-manifold: an edge {} is shared by {} triangles ({} such edges)",
-            near(mid),
-            list.len(),
-            bad.len()
-        ));
+        return Err(ImportError::SharedEdge {
+            at: Near(mid),
+            triangles: list.len(),
+            edges: bad.len(),
+        });
     }
     Ok(edges)
 }
@@ -290,9 +284,9 @@ fn keep_main_piece(
     triangles: Vec<[u32; 3]>,
     limits: &RepairLimits,
     repairs: &mut Repairs,
-) -> Result<Vec<[u32; 3]>, String> {
+) -> Result<Vec<[u32; 3]>, ImportError> {
     if triangles.is_empty() {
-        return Err("the mesh has no triangle of non-zero area".into());
+        return Err(ImportError::NoArea);
     }
     let edges = edge_map(vertices, &triangles)?;
     let mut piece = vec![usize::MAX; triangles.len()];
@@ -328,11 +322,10 @@ fn keep_main_piece(
         .filter(|&i| i != main && sizes[i] >= limit)
         .collect();
     if !big.is_empty() {
-        return Err(format!(
-            "the file holds {} separate pieces of {} triangles or more: one tooth per file",
-            big.len() + 1,
-            limit
-        ));
+        return Err(ImportError::SeveralPieces {
+            pieces: big.len() + 1,
+            limit,
+        });
     }
     repairs.debris_pieces += sizes.len() - 1;
     Ok(triangles
@@ -348,7 +341,7 @@ fn orient(
     vertices: &[Vec3],
     mut triangles: Vec<[u32; 3]>,
     repairs: &mut Repairs,
-) -> Result<Vec<[u32; 3]>, String> {
+) -> Result<Vec<[u32; 3]>, ImportError> {
     let edges = edge_map(vertices, &triangles)?;
     let runs = |t: &[u32; 3], a: u32, b: u32| (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b);
     let mut flip = vec![None::<bool>; triangles.len()];
@@ -375,10 +368,7 @@ fn orient(
                     }
                     Some(f) if f != want => {
                         let mid = (vertices[a as usize] + vertices[b as usize]) / 2.0;
-                        return Err(format!(
-                            "the surface cannot be oriented (a Möbius-like twist) at the edge {}",
-                            near(mid)
-                        ));
+                        return Err(ImportError::Twisted(Near(mid)));
                     }
                     Some(_) => {}
                 }
@@ -402,7 +392,7 @@ fn orient(
 }
 
 /// Boundary loops of a consistently wound surface, each in its edges' direction.
-fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, String> {
+fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, ImportError> {
     let mut directed = HashSet::with_capacity(mesh.triangles.len() * 3);
     for t in &mesh.triangles {
         for k in 0..3 {
@@ -418,10 +408,7 @@ fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, String> {
     boundary.sort_unstable();
     for &(a, b) in &boundary {
         if next.insert(a, b).is_some() {
-            return Err(format!(
-                "the mesh is non-manifold: two holes meet at the vertex {}",
-                near(mesh.vertices[a as usize])
-            ));
+            return Err(ImportError::HolesMeet(Near(mesh.vertices[a as usize])));
         }
     }
     let mut loops = Vec::new();
@@ -435,18 +422,14 @@ fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, String> {
         let mut cur = next[&start];
         while cur != start {
             if !done.insert(cur) {
-                return Err(format!(
-                    "the mesh is non-manifold at the vertex {}",
-                    near(mesh.vertices[cur as usize])
-                ));
+                return Err(ImportError::NonManifoldVertex(Near(
+                    mesh.vertices[cur as usize],
+                )));
             }
             l.push(cur);
-            cur = *next.get(&cur).ok_or_else(|| {
-                format!(
-                    "a hole's boundary does not close at the vertex {}",
-                    near(mesh.vertices[cur as usize])
-                )
-            })?;
+            cur = *next
+                .get(&cur)
+                .ok_or(ImportError::OpenBoundary(Near(mesh.vertices[cur as usize])))?;
         }
         loops.push(l);
     }

@@ -11,7 +11,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::repair::loop_centroid;
+use super::{error::ImportError, repair::loop_centroid};
 use crate::geometry::TriMesh;
 
 /// Rings between the margin and the apex.
@@ -51,16 +51,18 @@ fn surface_centroid(mesh: &TriMesh) -> Vec3 {
 
 /// Closes the margin `l` (in its edges' direction) of `mesh` with a root `root_length` mm long.
 /// Returns the margin's centroid (the cervical centre) and the unit apical direction.
+///
+/// # Errors
+/// [`ImportError::FlatMargin`] when the margin encloses no area.
 pub fn close_with_root(
     mesh: &mut TriMesh,
     l: &[u32],
     root_length: f32,
-) -> Result<(Vec3, Vec3), String> {
+) -> Result<(Vec3, Vec3), ImportError> {
     let points: Vec<Vec3> = l.iter().map(|&i| mesh.vertices[i as usize]).collect();
     let centre = loop_centroid(mesh, l);
     let crown = surface_centroid(mesh);
-    let mut apical = polygon_normal(&points)
-        .ok_or("the cervical margin encloses no area: cannot generate a root")?;
+    let mut apical = polygon_normal(&points).ok_or(ImportError::FlatMargin)?;
     if apical.dot(centre - crown) < 0.0 {
         apical = -apical;
     }

@@ -1,0 +1,134 @@
+//! `orthosim bench`: collision detection measured on seeded motions of real tooth pairs, per
+//! method, and one full-mouth step.
+
+use anyhow::Result;
+use clap::Args;
+use orthosim::{
+    collision::bench::{self, MethodReport},
+    teeth::{Case, Dentition},
+};
+
+use super::{
+    terminal::{print_json, progress_wanted},
+    tree_args::TreeArgs,
+};
+
+/// `bench`'s arguments.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Built-in case name or path to a .ron case file.
+    #[arg(long, default_value = "normal")]
+    pub case: String,
+    /// Number of pair motions.
+    #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+    pub pairs: u64,
+    #[command(flatten)]
+    pub trees: TreeArgs,
+    /// Seed of the motions.
+    #[arg(long, default_value_t = 0x5eed)]
+    pub seed: u64,
+    /// Tooth mesh resolution: `default` (the case's), `high` (scan resolution: 10,100
+    /// vertices, about 20,000 triangles per tooth) or a number of vertices per tooth.
+    #[arg(long, default_value = "default")]
+    pub resolution: BenchResolution,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `bench --resolution`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BenchResolution {
+    /// The case's own.
+    Default,
+    /// Vertices per procedural tooth.
+    Vertices(u32),
+}
+
+impl std::str::FromStr for BenchResolution {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "default" => Ok(Self::Default),
+            "high" => Ok(Self::Vertices(10_100)),
+            _ => match s.parse::<u32>() {
+                Ok(n) if (20..=200_000).contains(&n) => Ok(Self::Vertices(n)),
+                _ => Err(format!(
+                    "'{s}': use default, high or a number of vertices per tooth (20–200000)"
+                )),
+            },
+        }
+    }
+}
+
+/// Builds the teeth and their trees, measures and prints the report.
+pub fn run(args: BenchArgs) -> Result<()> {
+    let mut loaded = Case::resolve(&args.case)?;
+    if let BenchResolution::Vertices(n) = args.resolution {
+        loaded.case.resolution = Some(n);
+    }
+    let dentition = Dentition::build(loaded)?;
+    let progress = progress_wanted();
+    if progress {
+        eprint!("building trees…");
+    }
+    let teeth = bench::bench_teeth(
+        &dentition,
+        args.trees.settings(),
+        args.trees.cache().as_ref(),
+    )?;
+    let pairs = args.pairs as usize;
+    let near = bench::near_contact_pairs(&teeth, pairs, args.seed);
+    let stress = bench::stress_pairs(&teeth, pairs, args.seed);
+    let bar = |done: usize, total: usize| {
+        if progress {
+            eprint!("\rmeasuring {done}/{total}          ");
+            if done == total {
+                eprintln!();
+            }
+        }
+    };
+    let report = bench::run(&teeth, &near, &stress, &bar);
+    if args.json {
+        return print_json(&report);
+    }
+    let tree = args.trees.tree;
+    table(
+        format!(
+            "{} near-contact pair steps, {tree:?} trees (depth 4)",
+            report.pairs
+        ),
+        &report.methods,
+    );
+    table(
+        format!(
+            "{} stress pair steps (0.01–5 mm, ±15°), {tree:?} trees (depth 4)",
+            report.stress.pairs
+        ),
+        &report.stress.methods,
+    );
+    println!(
+        "full-mouth step (continuous): {:.1} µs",
+        report.full_mouth_step_us
+    );
+    Ok(())
+}
+
+fn table(title: String, methods: &[MethodReport]) {
+    println!("{title}");
+    println!(
+        "{:>11} {:>11} {:>9} {:>9} {:>14} {:>13}",
+        "method", "µs/pair", "false neg", "false pos", "mean error mm", "max error mm"
+    );
+    for m in methods {
+        println!(
+            "{:>11} {:>11.2} {:>9} {:>9} {:>14.4} {:>13.4}",
+            m.method,
+            m.us_per_pair,
+            m.false_negatives,
+            m.false_positives,
+            m.mean_error_mm,
+            m.max_error_mm
+        );
+    }
+}

@@ -1,0 +1,110 @@
+//! `orthosim screenshot`: the real window on a case, simulated for some frames once its trees are
+//! built, saved as a PNG.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+#[cfg(feature = "viewer")]
+use orthosim::occlusion_view::{CameraPreset, Overlay, Roots};
+use orthosim::{collision::Method, sphere_tree::TreeMethod};
+
+use super::choice;
+
+/// `screenshot`'s arguments.
+#[derive(Args, Debug)]
+pub struct ScreenshotArgs {
+    /// Built-in case name or path to a .ron case file.
+    #[arg(long, default_value = "normal")]
+    pub case: String,
+    /// Camera view.
+    #[cfg(feature = "viewer")]
+    #[arg(long, value_parser = choice::camera(), default_value_t = CameraPreset::Frontal)]
+    pub view: CameraPreset,
+    /// Frames to run once the simulation is ready (trees built).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub frames: u32,
+    /// Sphere-tree builder (depth 4, branching 8; medial from the user's tree cache).
+    #[arg(long, value_parser = choice::tree_method(), default_value_t = TreeMethod::Medial)]
+    pub tree: TreeMethod,
+    /// Overlays: `spheres:LEVEL` (a sphere-tree level, 0 = root), `contacts` (overlapping leaf
+    /// spheres and contact points of the step), `occlusion-map` (surfaces coloured by their
+    /// distance to the opposing arch) or `circles` (bounding circles, with `--algorithm
+    /// circles`); repeat for several.
+    #[cfg(feature = "viewer")]
+    #[arg(long)]
+    pub overlay: Vec<Overlay>,
+    /// Narrow-phase method of the simulation.
+    #[arg(long, value_parser = choice::method(), default_value_t = Method::Continuous)]
+    pub algorithm: Method,
+    /// How roots are drawn: translucent, solid or hidden.
+    #[cfg(feature = "viewer")]
+    #[arg(long, default_value = "translucent")]
+    pub roots: Roots,
+    /// Hide an arch (`upper` or `lower`), e.g. to see the other one's occlusal surface.
+    #[arg(long, value_parser = ["upper", "lower"])]
+    pub hide: Vec<String>,
+    /// The PNG file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Takes the screenshot: checks the case and the output first, then runs the window until the
+/// picture is written.
+#[cfg(feature = "viewer")]
+pub fn run(args: ScreenshotArgs) -> Result<()> {
+    use std::sync::{Arc, Mutex};
+
+    use orthosim::{
+        collision::CollisionSettings,
+        occlusion_view::{OcclusionViewPlugin, Overlays, ScreenshotOutcome, ScreenshotPlugin},
+        teeth::Case,
+    };
+    Case::resolve(&args.case)?;
+    if args.out.extension().and_then(|e| e.to_str()) != Some("png") {
+        anyhow::bail!("{}: the screenshot must be a .png file", args.out.display());
+    }
+    orthosim::io::check_output(&args.out, &[std::path::Path::new(&args.case)])?;
+    let shared = Arc::new(Mutex::new(ScreenshotOutcome::default()));
+    let overlays = Overlays {
+        hide_upper: args.hide.iter().any(|h| h == "upper"),
+        hide_lower: args.hide.iter().any(|h| h == "lower"),
+        roots: args.roots,
+        ..args
+            .overlay
+            .iter()
+            .fold(Overlays::default(), |o, x| o.with(*x))
+    };
+    let mut app = super::view::window_app(&args.case, args.tree);
+    app.insert_resource(CollisionSettings {
+        method: args.algorithm,
+    })
+    .add_plugins(OcclusionViewPlugin {
+        initial_view: args.view,
+        overlays,
+        ..Default::default()
+    })
+    .add_plugins(ScreenshotPlugin {
+        path: args.out.clone(),
+        frames: args.frames,
+        outcome: shared.clone(),
+    });
+    app.run();
+    let outcome = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    match outcome.error {
+        Some(e) => anyhow::bail!("{e}"),
+        None if outcome.written => {
+            println!("wrote {}", args.out.display());
+            Ok(())
+        }
+        None => anyhow::bail!("the window closed before the screenshot was taken"),
+    }
+}
+
+/// Without the viewer: says so.
+#[cfg(not(feature = "viewer"))]
+pub fn run(args: ScreenshotArgs) -> Result<()> {
+    let _ = (args.frames, args.tree, args.algorithm, args.hide, args.out);
+    orthosim::teeth::Case::resolve(&args.case)?;
+    super::view::no_viewer()
+}

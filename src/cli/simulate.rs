@@ -1,0 +1,126 @@
+//! `orthosim simulate`: a case run headless until its teeth rest, and where they went.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use orthosim::{
+    collision::Method,
+    movement::{MovementSettings, Response, SimulationReport, run_case},
+};
+
+use super::{
+    choice,
+    terminal::{print_json, progress_wanted},
+    tree_args::TreeArgs,
+};
+
+/// `simulate`'s arguments.
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// Built-in case name or path to a .ron case file.
+    #[arg(long, default_value = "case1")]
+    pub case: String,
+    /// Narrow-phase method.
+    #[arg(long, value_parser = choice::method(), default_value_t = Method::Continuous)]
+    pub algorithm: Method,
+    /// Collision response.
+    #[arg(long, value_parser = choice::response(), default_value_t = Response::Block)]
+    pub response: Response,
+    /// Most steps to run.
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
+    pub max_steps: u64,
+    #[command(flatten)]
+    pub trees: TreeArgs,
+    /// Movement settings (a RON `MovementSettings`; missing fields keep their defaults);
+    /// `--response` overrides the file's response.
+    #[arg(long)]
+    pub settings: Option<PathBuf>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the case and prints the report.
+pub fn run(args: SimulateArgs) -> Result<()> {
+    let mut settings = match &args.settings {
+        Some(path) => MovementSettings::load(path)?,
+        None => MovementSettings::default(),
+    };
+    settings.response = args.response;
+    let progress = progress_wanted();
+    if progress {
+        eprint!("building trees…");
+    }
+    let max_steps = args.max_steps;
+    let run = run_case(
+        &args.case,
+        args.algorithm,
+        settings,
+        args.trees.settings(),
+        args.trees.cache().as_ref(),
+        max_steps,
+        |step| {
+            if progress && (step % 50 == 0 || step == max_steps) {
+                eprint!("\rsimulating: step {step}/{max_steps}          ");
+            }
+        },
+    )?;
+    if progress {
+        eprintln!();
+    }
+    if args.json {
+        return print_json(&run.report);
+    }
+    print_table(&run.report);
+    Ok(())
+}
+
+fn print_table(r: &SimulationReport) {
+    println!(
+        "case {}, {} / {}: {} steps, {}",
+        r.case,
+        r.algorithm,
+        r.response,
+        r.steps,
+        if r.at_rest {
+            "at rest"
+        } else {
+            "not at rest (step limit)"
+        }
+    );
+    println!(
+        "moved (> 0.1 mm): {}",
+        r.moved
+            .iter()
+            .map(|f| f.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    println!("{:>7} {:>14} {:>12}", "pair", "centre dist mm", "gap mm");
+    for d in &r.distances {
+        println!(
+            "{:>7} {:>14.3} {:>12.4}",
+            format!("{}-{}", d.a, d.b),
+            d.centre_distance_mm,
+            d.surface_gap_mm
+        );
+    }
+    println!(
+        "total centre distance {:.3} mm, max penetration {:.4} mm",
+        r.total_centre_distance_mm, r.max_penetration_mm
+    );
+    println!(
+        "{:.1} µs per step ({:.1} µs collision)",
+        r.step_us, r.collision_us_per_step
+    );
+    for (pair, mm) in &r.ipr_mm {
+        println!("IPR {pair}: {mm:.3} mm");
+    }
+    if r.impacts > 0 {
+        println!(
+            "{} impacts, {:.3e} µJ of kinetic energy lost",
+            r.impacts, r.energy_lost_uj
+        );
+    }
+}

@@ -1,0 +1,39 @@
+//! The panel's **Simulation** section: play, pause, single step, speed.
+
+use bevy::prelude::*;
+use bevy_egui::egui;
+
+use super::PanelState;
+
+/// Play / pause the virtual clock, ask for a single step while paused, set the speed.
+pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, time: &mut Time<Virtual>) {
+    ui.heading("Simulation");
+    ui.horizontal(|ui| {
+        let paused = time.is_paused();
+        if ui
+            .button(if paused { "▶ Play" } else { "⏸ Pause" })
+            .clicked()
+        {
+            if paused {
+                time.unpause();
+            } else {
+                time.pause();
+            }
+        }
+        if ui.add_enabled(paused, egui::Button::new("Step")).clicked() {
+            state.step = true;
+        }
+    });
+    let mut speed = state.speed;
+    if ui
+        .add(
+            egui::Slider::new(&mut speed, 0.1..=8.0)
+                .text("speed ×")
+                .logarithmic(true),
+        )
+        .changed()
+    {
+        state.speed = speed;
+        time.set_relative_speed(speed);
+    }
+}
