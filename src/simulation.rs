@@ -3,7 +3,7 @@
 //!
 //! This plugin alone declares and chains the stages, so disabling or replacing any other plugin
 //! never unorders the rest. It also nests the collision plugin's sets
-//! ([`CollisionSystems`](crate::collision::CollisionSystems)) in their stages, since collision is
+//! ([`CollisionSystems`]) in their stages, since collision is
 //! the layer below; the plugins above (movement) nest their own sets, and add this plugin, in
 //! their schedule, when the app does not have it yet.
 //!
@@ -42,18 +42,6 @@ pub enum SimulationSystems {
     Resolve,
     /// End poses written to `Transform`.
     Commit,
-}
-
-impl SimulationSystems {
-    /// The stages in their order.
-    pub const ALL: [SimulationSystems; 6] = [
-        SimulationSystems::Loads,
-        SimulationSystems::Motion,
-        SimulationSystems::BroadPhase,
-        SimulationSystems::NarrowPhase,
-        SimulationSystems::Resolve,
-        SimulationSystems::Commit,
-    ];
 }
 
 /// The schedule the simulation runs in, for code that runs a step by hand (the panel's single

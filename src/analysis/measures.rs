@@ -24,10 +24,7 @@
 use serde::Serialize;
 
 use crate::{
-    geometry::{
-        MeshRef, Pose,
-        mesh_distance::{closest_point_on_mesh, point_inside_mesh},
-    },
+    geometry::{MeshRef, Pose, closest_point_on_mesh, point_inside_mesh},
     sphere_tree::coverage::split4,
     teeth::{Arch, Fdi, ToothGeometry},
 };

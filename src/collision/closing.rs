@@ -7,7 +7,7 @@
 //! |---|---|---|
 //! | circles | the circle centres get closer over the step (by more than [`APPROACH_MM`]) | never |
 //! | spheres | some overlapping leaf pair's centres get closer over the step (by more than [`APPROACH_MM`]) | the deepest leaf-sphere overlap at the end exceeds the deepest at the start by more than [`DEEPEN_MM`] |
-//! | continuous | some overlapping leaf pair's centres approach at time t (d/dt of the squared distance below −[`APPROACH_MM2`], in f64) | as for spheres, with the end's overlapping leaves found afresh |
+//! | continuous | some overlapping leaf pair's centres approach at time t of the step (half the rate of change of their squared distance, in f64, below −[`APPROACH_MM2`]) | as for spheres, with the end's overlapping leaves found afresh |
 //! | exact | the contact points' relative velocity along the normal, at time t, is below −[`APPROACH_MM`] per step | the meshes overlap at the end more deeply than the contact's depth by more than [`DEEPEN_MM`] |
 //!
 //! [`closes_in`] combines them for a contact that touches at the start of the step (for the
@@ -26,7 +26,8 @@ use crate::geometry::{Pose, mesh_separation};
 
 /// A distance must fall by more than this (mm per step) to count as approaching.
 pub const APPROACH_MM: f32 = 1e-7;
-/// The continuous test's threshold on d/dt of a squared distance (mm² per step, in f64).
+/// The continuous test's threshold on half the rate of change of a squared distance (mm² per
+/// step, in f64).
 pub const APPROACH_MM2: f64 = 1e-12;
 /// An overlap must grow by more than this (mm) to count as deepening.
 pub const DEEPEN_MM: f32 = 1e-6;

@@ -4,7 +4,7 @@
 //! [`shape`] (a tooth's compact sphere tree and bounding circle), [`broad_phase`] (arch neighbours and
 //! opposing teeth whose swept root spheres can meet), [`narrow_phase`] (circles, spheres,
 //! continuous and exact, with their guarantees), [`closing`] (whether a contact's teeth close in,
-//! per method, with its tolerances) and [`bench`] (the `orthosim bench` measurements). ECS layer
+//! per method, with its tolerances) and [`bench`](mod@bench) (the `orthosim bench` measurements). ECS layer
 //! (feature `ecs`): `CollisionPlugin`.
 
 pub mod bench;

@@ -4,20 +4,20 @@
 //! Nothing here touches the ECS; every function is callable from a test, a benchmark or another
 //! engine. Lengths are millimetres.
 
-pub mod aabb;
-pub mod bvh;
-pub mod closest;
+mod aabb;
+mod bvh;
+mod closest;
 pub(crate) mod columns;
-pub mod decimate;
+pub(crate) mod decimate;
 pub(crate) mod interval;
 pub(crate) mod lanes;
-pub mod mass;
-pub mod mesh_distance;
-pub mod pose;
-pub mod ray;
-pub mod sphere;
-pub mod stars;
-pub mod trimesh;
+mod mass;
+mod mesh_distance;
+mod pose;
+pub(crate) mod ray;
+pub(crate) mod sphere;
+mod stars;
+pub(crate) mod trimesh;
 
 pub use aabb::Aabb;
 pub use bvh::TriangleBvh;
@@ -29,7 +29,8 @@ pub use closest::{
 pub(crate) use columns::{Columns, LocalLines};
 pub use mass::MassProperties;
 pub use mesh_distance::{
-    MeshRef, MeshSeparation, NearContact, mesh_penetration, mesh_penetration_near, mesh_separation,
+    MeshRef, MeshSeparation, NearContact, closest_point_on_mesh, closest_point_on_mesh_within,
+    closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation, point_inside_mesh,
 };
 pub use pose::Pose;
 pub use sphere::Sphere;

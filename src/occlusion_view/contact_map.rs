@@ -14,10 +14,7 @@ use bevy::{mesh::VertexAttributeValues, prelude::*};
 
 use super::{Overlays, tooth_render::ToothRenderAssets};
 use crate::{
-    geometry::{
-        MeshRef,
-        mesh_distance::{closest_point_on_mesh, point_inside_mesh},
-    },
+    geometry::{MeshRef, closest_point_on_mesh, point_inside_mesh},
     teeth::{Extracted, Tooth, ToothShape},
 };
 

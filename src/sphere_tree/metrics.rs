@@ -1,6 +1,6 @@
 //! Fit of a sphere tree to its mesh: the paper's relative outside volume and related measures.
 //!
-//! Method and error: volumes are integrated over the lines of a [`Columns`] lattice of
+//! Method and error: volumes are integrated over the lines of a `Columns` lattice of
 //! `METRIC_LINES` lines across the tooth's two short extents (cell about 0.025 mm on a 10-mm crown):
 //! exact along every line (the line's inside intervals against each sphere's chord, or against the
 //! merged chords of all leaves for the union), the midpoint rule across lines. Against exact
@@ -16,10 +16,7 @@ use super::{
     coverage::{DEFAULT_SPLIT_DEPTH, check_coverage},
     tree::SphereTree,
 };
-use crate::geometry::{
-    Columns, MeshRef, Sphere,
-    mesh_distance::{closest_point_on_mesh, point_inside_mesh},
-};
+use crate::geometry::{Columns, MeshRef, Sphere, closest_point_on_mesh, point_inside_mesh};
 
 /// Lattice lines across the tooth for the fit volumes.
 pub const METRIC_LINES: usize = 400;

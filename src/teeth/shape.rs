@@ -10,7 +10,7 @@
 //! construction. Each vertex lies on the ray from the star centre in its own direction, and the
 //! triangles' directions tile the sphere once (a subdivided cube projected onto the sphere), so no
 //! two triangles can cross; simplification keeps every triangle facing away from the centre
-//! ([`crate::geometry::decimate`]). Crowns carry an incisal edge (incisors), a cusp tip (canines) or
+//! (`crate::geometry::decimate`). Crowns carry an incisal edge (incisors), a cusp tip (canines) or
 //! cusps around a central fossa (premolars 2, molars 4); roots taper to a rounded apex, with 1–3
 //! roots as in [`super::anatomy`].
 

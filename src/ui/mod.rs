@@ -1,21 +1,21 @@
 //! `OrthoSimUiPlugin` (feature `viewer`): the egui control panel, one function per heading, and
 //! the teeth-and-loads window.
 //!
-//! - **Case** ([`case`]): load a built-in case or a case file (the error shown if it fails), reset
+//! - **Case** (`case`): load a built-in case or a case file (the error shown if it fails), reset
 //!   the current one.
-//! - **Simulation** ([`simulation`]): play / pause, single step (one run of the simulation
+//! - **Simulation** (`simulation`): play / pause, single step (one run of the simulation
 //!   schedule), speed (the virtual clock's rate, which drives the fixed simulation step).
-//! - **Collision** ([`collision`]): narrow-phase method and response apply at once; a new tree
+//! - **Collision** (`collision`): narrow-phase method and response apply at once; a new tree
 //!   builder or depth rebuilds the trees in the background and restarts the case. Tree builds in
 //!   the background show a progress bar.
-//! - **View** ([`view`]): show or hide each arch; roots translucent, solid or hidden; overlays: a
+//! - **View** (`view`): show or hide each arch; roots translucent, solid or hidden; overlays: a
 //!   sphere-tree level of every tooth, the contacts of the step, the occlusal contact map, the
 //!   bounding circles while the circles algorithm is active.
-//! - **Readouts** ([`readouts`]): steps, teeth moving, frame rate, collision time per step (broad
+//! - **Readouts** (`readouts`): steps, teeth moving, frame rate, collision time per step (broad
 //!   phase to response), the contacts of the last step, IPR totals, and the surface gap of every
 //!   adjacent pair as a plot with the 1 mm line (measured a few times a second, only while the
 //!   panel shows it).
-//! - **Teeth and loads** ([`teeth`], its own window): select teeth by clicking them (shift-click
+//! - **Teeth and loads** (`teeth`, its own window): select teeth by clicking them (shift-click
 //!   for a group) or from an FDI chart, and set a force or torque on them with presets along each
 //!   tooth's mesial, buccal and occlusal axes. The selected teeth can also get a round or
 //!   rectangular wire, or be extracted and restored while the case runs (a refused restore shows

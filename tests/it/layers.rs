@@ -27,6 +27,13 @@ fn src() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
 }
 
+/// Every `.rs` file under src/, in a fixed order.
+fn source_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    files
+}
+
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let mut entries: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
@@ -113,8 +120,7 @@ fn named_layers(text: &str) -> BTreeSet<String> {
 
 #[test]
 fn every_import_points_down_the_layers() {
-    let mut files = Vec::new();
-    rust_files(&src(), &mut files);
+    let files = source_files();
     let mut upward = Vec::new();
     let mut unknown = BTreeSet::new();
     for path in &files {
@@ -171,8 +177,7 @@ fn the_layer_check_sees_an_upward_import() {
 
 #[test]
 fn no_source_file_is_longer_than_700_lines_and_main_only_dispatches() {
-    let mut files = Vec::new();
-    rust_files(&src(), &mut files);
+    let files = source_files();
     let long: Vec<String> = files
         .iter()
         .filter_map(|p| {
@@ -191,8 +196,7 @@ fn no_source_file_is_longer_than_700_lines_and_main_only_dispatches() {
 
 #[test]
 fn the_library_returns_typed_errors() {
-    let mut files = Vec::new();
-    rust_files(&src(), &mut files);
+    let files = source_files();
     let stringly: Vec<String> = files
         .iter()
         .filter(|p| layer_of(p.strip_prefix(src()).unwrap()).is_some_and(|l| l != "cli"))

@@ -9,7 +9,7 @@
 //! 1. **Interval test.** |A + B·[0, 1]|² is bounded below component by component (each component
 //!    of A + B·t lies between its values at t = 0 and t = 1); if the bound exceeds (r₁ + r₂)² the
 //!    spheres cannot meet during the step. It runs on eight sibling spheres at once, in f32, with
-//!    the contact distance widened by the rounding slack of [`super::lanes`].
+//!    the contact distance widened by the rounding slack of `super::lanes`.
 //! 2. **First time (Eq. 2)**, for every node pair that passes, inner or leaf:
 //!    t = (|A|² − R²) / (−A·B + √((A·B)² − |B|²(|A|² − R²))), the conjugate form of the paper's
 //!    root, which has no cancellation; overlap at t = 0 gives 0; |B|² = 0, A·B ≥ 0 or a negative
@@ -21,7 +21,7 @@
 //!
 //! 3. **Descent.** A pair of inner nodes with up to eight children each is split on both sides at
 //!    once: the children of each side whose swept spheres meet the other node, then all pairs of
-//!    those (an 8 × 8 block of interval tests, [`Lanes::swept_block`]), and Eq. 2 for the pairs
+//!    those (an 8 × 8 block of interval tests, `Lanes::swept_block`), and Eq. 2 for the pairs
 //!    that pass. Dropping children that miss the other node is safe: where the surfaces touch at
 //!    time t, the contact point lies in a leaf of each tree and, by the coverage invariant, in
 //!    every ancestor of either at time t, so all those ancestors' swept spheres meet. Other pairs
@@ -137,7 +137,7 @@ pub fn first_contact(a: DVec3, b: DVec3, r: f64) -> Option<f64> {
 /// skipped (the earliest time is still exact; later pairs may be left out).
 ///
 /// Centres are mapped in f32 relative to the first tooth's start position, a group of siblings at
-/// a time and once per query ([`super::lanes`]); the interval test runs on whole groups, and the
+/// a time and once per query (`super::lanes`); the interval test runs on whole groups, and the
 /// time (Eq. 2, in f64) only for the lanes that pass it. The contact distance carries the f32
 /// slack of [`f32_slack`], so the time stays conservative for the real motion.
 pub fn swept_leaves(
@@ -221,7 +221,7 @@ struct Descent<'q, F> {
 }
 
 /// The first time (Eq. 2) of a node pair that passed the interval test, from f32 centres: the
-/// contact distance carries the slack and the growth of [`super::lanes`], so the time is not
+/// contact distance carries the slack and the growth of `super::lanes`, so the time is not
 /// after the real one.
 #[inline]
 fn pair_time(a: (Vec3, Vec3, f32), b: (Vec3, Vec3, f32), slack: f32) -> Option<f64> {

@@ -1,6 +1,6 @@
 //! Discrete sphere trees: simultaneous descent of both trees at the end pose, collecting every
 //! overlapping leaf pair. Conservative at that pose: surfaces that touch lie in overlapping leaves
-//! (the coverage invariant), and node tests allow for rounding (see [`super::lanes`]).
+//! (the coverage invariant), and node tests allow for rounding (see `super::lanes`).
 //!
 //! The descent runs in the first tooth's local frame: its spheres are used as stored and only the
 //! second tooth's are mapped, a group of siblings at a time and once per query.
@@ -10,7 +10,7 @@
 //! is safe: a surface point where the teeth touch lies in a leaf of each tree and, by the coverage
 //! invariant, in every ancestor of either leaf, so every pair of those ancestors meets. The
 //! children are tested all against all, 8 × 8 lanes in eight vector tests without branches (see
-//! [`Lanes::block`]), which costs less than testing only the candidates one by one.
+//! `Lanes::block`), which costs less than testing only the candidates one by one.
 
 use glam::{DVec3, Vec3};
 

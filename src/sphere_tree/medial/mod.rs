@@ -2,7 +2,7 @@
 //! weighted set cover of the surface that minimises the paper's outside volume, shrunk and polished
 //! on a fine lattice of surface points, made exact, then grouped into a balanced hierarchy.
 //!
-//! 1. **Pieces.** Every triangle is split with [`split4`] (the split the coverage check uses) until
+//! 1. **Pieces.** Every triangle is split with `split4` (the split the coverage check uses) until
 //!    its pieces are shorter than 0.3 s, where s = √(area / leaf budget) is the leaf spacing.
 //! 2. **Medial centres.** For 5 seeds per leaf of the budget, spread evenly by area, the maximal
 //!    inscribed ball tangent at the seed, by the shrinking-ball method (Ma, Bae, Choi and Lee
@@ -14,7 +14,7 @@
 //! 3. **Candidates.** Each medial ball grown by a geometric series of margins (fractions of s). A
 //!    candidate covers the pieces whose three corners it holds and is shrunk to the farthest of
 //!    them; its cost is its volume outside the tooth, by exact line integrals over a lattice
-//!    ([`Columns`], all margins of a ball in one pass over the lines, skipping lines whose chord
+//!    (`Columns`, all margins of a ball in one pass over the lines, skipping lines whose chord
 //!    through the largest margin lies inside the tooth). A tiny sphere around each piece no
 //!    candidate covers, and the smallest sphere around the whole mesh, keep the cover always
 //!    feasible.
@@ -33,7 +33,7 @@
 //!    each sphere's centre is moved by a pattern search that lowers its outside volume while it
 //!    holds its points: eight trial centres at a time, their farthest points in one pass over the
 //!    points and their outside volumes in one pass over the lattice lines gathered around the
-//!    sphere ([`LocalLines`], without the lines whose chord stays inside the tooth). Piece corners
+//!    sphere (`LocalLines`, without the lines whose chord stays inside the tooth). Piece corners
 //!    are numbered once, so a corner shared by six pieces is placed once, and so are the points
 //!    inside a piece edge, which the pieces on either side share. A piece whose three corners go
 //!    to one sphere goes to it whole, without testing its inner points: the sphere holds its
@@ -53,7 +53,7 @@
 //!    centres, recursively; each inner sphere is the smallest sphere around the pieces its leaves
 //!    are responsible for, so invariant (2) holds by construction.
 //!
-//! **Instruction sets.** The whole build runs through [`lanes::run`]: on a processor with AVX2 its
+//! **Instruction sets.** The whole build runs through `lanes::run`: on a processor with AVX2 its
 //! lane loops (candidate piece scans and costs, shrinking, polishing) are compiled as 256-bit
 //! operations, elsewhere as SSE2 halves, with the same result bit for bit (tested).
 //!
