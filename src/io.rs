@@ -228,7 +228,9 @@ impl OutputSet {
                 source,
             }
         })?;
-        self.written.push((tmp, index));
+        if !self.written.iter().any(|(_, k)| *k == index) {
+            self.written.push((tmp, index));
+        }
         Ok(())
     }
 
