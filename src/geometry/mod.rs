@@ -15,6 +15,7 @@ mod mass;
 mod mesh_distance;
 mod pose;
 pub(crate) mod ray;
+pub(crate) mod rng;
 pub(crate) mod sphere;
 mod stars;
 pub(crate) mod trimesh;

@@ -296,6 +296,26 @@ impl TriMesh {
         found
     }
 
+    /// Every pair of non-adjacent triangles (sharing no vertex) that intersect, up to `limit`
+    /// pairs, each as (smaller index, larger index), sorted. The same test as
+    /// [`TriMesh::find_self_intersection`], for repairs that need all the places at once.
+    pub fn self_intersections(&self, limit: usize) -> Vec<(usize, usize)> {
+        let bvh = super::bvh::TriangleBvh::build(self);
+        let mut found = Vec::new();
+        bvh.self_pairs(&mut |i, j| {
+            let (ti, tj) = (self.triangles[i], self.triangles[j]);
+            if ti.iter().any(|v| tj.contains(v)) {
+                return true;
+            }
+            if super::closest::triangles_intersect(&self.triangle(i), &self.triangle(j)) {
+                found.push((i.min(j), i.max(j)));
+            }
+            found.len() < limit
+        });
+        found.sort_unstable();
+        found
+    }
+
     /// [`TriMesh::validate`] followed by the self-intersection check.
     pub fn validate_solid(&self) -> Result<MeshReport, MeshError> {
         let report = self.validate()?;

@@ -1,8 +1,9 @@
 //! Teeth: FDI numbers, the anatomy table, procedural tooth meshes, arch forms, patient cases, mesh
-//! import, and (feature `ecs`) the `TeethModelPlugin` that spawns tooth entities.
+//! import, scan-like test data, and (feature `ecs`) the `TeethModelPlugin` that spawns tooth
+//! entities.
 //!
 //! Engine-free parts (`fdi`, `anatomy`, `shape`, `frame`, `tooth_shape`, `arch`, `case`,
-//! `dentition`, `load`, `import`) need no `World`; `components` and `plugin` are the ECS layer.
+//! `dentition`, `load`, `import`, `scan_like`) need no `World`; `components` and `plugin` are the ECS layer.
 
 pub mod anatomy;
 pub mod arch;
@@ -17,6 +18,7 @@ mod load;
 mod memo;
 #[cfg(feature = "ecs")]
 mod plugin;
+pub mod scan_like;
 pub mod shape;
 mod tooth_shape;
 

@@ -253,6 +253,51 @@ fn each_repair_is_made_and_reported() {
     let t = import(&m, 36).unwrap();
     assert_eq!(t.repairs.debris_pieces, 1);
     assert!(t.repairs.summary().contains("loose pieces dropped"));
+
+    // A fin: a third triangle on an edge. The edge's triangles go, and the hole is closed.
+    let mut m = mesh.clone();
+    let [a, b, _] = mesh.triangles[0];
+    m.vertices.push(mesh.aabb().max + Vec3::ONE);
+    m.triangles.push([a, b, m.vertices.len() as u32 - 1]);
+    let t = import(&m, 36).unwrap();
+    assert_eq!(t.repairs.fin_triangles, 3);
+    assert_eq!(t.repairs.holes_closed_mm.len(), 1);
+    assert!((world_of(&t).signed_volume() - volume).abs() < 0.02 * volume);
+
+    // A bow-tie: two triangles of one vertex's fan removed, so two holes meet at the vertex.
+    let mut m = mesh.clone();
+    let v = m.triangles[40][0];
+    let fan: Vec<usize> = (0..m.triangles.len())
+        .filter(|&i| m.triangles[i].contains(&v))
+        .collect();
+    let shares_edge = |i: usize, j: usize| {
+        m.triangles[i]
+            .iter()
+            .filter(|x| m.triangles[j].contains(x))
+            .count()
+            > 1
+    };
+    let other = *fan[1..].iter().find(|&&j| !shares_edge(fan[0], j)).unwrap();
+    let (hi, lo) = (fan[0].max(other), fan[0].min(other));
+    m.triangles.remove(hi);
+    m.triangles.remove(lo);
+    let t = import(&m, 36).unwrap();
+    assert_eq!(t.repairs.split_vertices, 1, "{:?}", t.repairs);
+    // Split, the vertex's two copies join the two holes into one opening, closed at once.
+    assert_eq!(t.repairs.holes_closed_mm.len(), 1);
+    assert!((world_of(&t).signed_volume() - volume).abs() < 0.02 * volume);
+
+    // A spike: the highest cusp's vertex pulled 12 mm out along its normal goes back among its neighbours.
+    let mut m = mesh.clone();
+    let normals = mesh.vertex_normals();
+    let top = (0..mesh.vertices.len())
+        .max_by(|&a, &b| mesh.vertices[a].y.total_cmp(&mesh.vertices[b].y))
+        .unwrap();
+    m.vertices[top] += normals[top] * 12.0;
+    let t = import(&m, 36).unwrap();
+    assert_eq!(t.repairs.spikes_smoothed, 1, "{:?}", t.repairs);
+    assert!((world_of(&t).signed_volume() - volume).abs() < 0.02 * volume);
+    assert!(t.repairs.summary().contains("spikes smoothed"));
 }
 
 #[test]
@@ -302,7 +347,10 @@ fn broken_meshes_are_refused_with_the_reason() {
     let d = normal();
     let (mesh, _, _) = world_tooth(&d, 36);
     let refuse = |m: &TriMesh, what: &str| {
-        let e = import(m, 36).unwrap_err().to_string();
+        let e = match import(m, 36) {
+            Ok(t) => panic!("expected '{what}', imported: {}", t.repairs.summary()),
+            Err(e) => e.to_string(),
+        };
         assert!(e.contains(what), "expected '{what}' in: {e}");
     };
     refuse(&TriMesh::default(), "empty");
@@ -311,38 +359,21 @@ fn broken_meshes_are_refused_with_the_reason() {
     let mut m = mesh.clone();
     m.vertices[3].x = f32::NAN;
     refuse(&m, "non-finite");
-    // A third triangle on an edge.
-    let mut m = mesh.clone();
-    let [a, b, _] = mesh.triangles[0];
-    m.vertices.push(mesh.aabb().max + Vec3::ONE);
-    m.triangles.push([a, b, m.vertices.len() as u32 - 1]);
-    refuse(&m, "non-manifold");
-    // Large openings: around the crown's highest point, and also around the root's apex.
-    let centroid = |m: &TriMesh, t: &[u32; 3]| {
-        (m.vertices[t[0] as usize] + m.vertices[t[1] as usize] + m.vertices[t[2] as usize]) / 3.0
-    };
-    let top = mesh
-        .vertices
-        .iter()
-        .copied()
-        .max_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap();
-    let apex = mesh
-        .vertices
-        .iter()
-        .copied()
-        .min_by(|a, b| a.y.total_cmp(&b.y))
-        .unwrap();
-    let mut crown_open = mesh.clone();
-    crown_open
-        .triangles
-        .retain(|t| centroid(&mesh, t).distance(top) > 3.0);
-    // One opening on the occlusal side is not a crown's margin.
-    refuse(&crown_open, "does not face the root's side");
-    let mut both = crown_open.clone();
-    both.triangles
-        .retain(|t| centroid(&mesh, t).distance(apex) > 3.0);
-    refuse(&both, "2 openings");
+    // A crown upside down: its margin faces the occlusal side.
+    let crown = d.tooth(Fdi::new(36).unwrap()).unwrap();
+    let f = &crown.geometry.frame;
+    let mut cut = crown.geometry.mesh.clone();
+    let local = crown.geometry.mesh.clone();
+    cut.triangles.retain(|t| {
+        let c = (local.vertices[t[0] as usize]
+            + local.vertices[t[1] as usize]
+            + local.vertices[t[2] as usize])
+            / 3.0;
+        (c - f.cervical_centre).dot(f.long_axis) > 0.0
+    });
+    let flip = glam::Quat::from_rotation_x(std::f32::consts::PI);
+    let upside_down = cut.map_vertices(|v| crown.pose.transform_point(flip * v));
+    refuse(&upside_down, "does not face the root's side");
     // Two teeth in one file.
     let mut m = mesh.clone();
     let (other, _, _) = world_tooth(&d, 46);
@@ -351,11 +382,10 @@ fn broken_meshes_are_refused_with_the_reason() {
     m.triangles
         .extend(other.triangles.iter().map(|t| t.map(|i| i + base)));
     refuse(&m, "separate pieces");
-    // A vertex pulled through the far side of the tooth.
-    let mut m = mesh.clone();
+    // The crown turned sideways through the root: crossings over far more than the repair cuts.
     let c = mesh.aabb().centre();
-    let v = m.vertices[10];
-    m.vertices[10] = c + (c - v) * 1.5;
+    let turn = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let m = mesh.map_vertices(|v| if v.y > c.y { c + turn * (v - c) } else { v });
     refuse(&m, "intersects itself");
 }
 

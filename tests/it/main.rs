@@ -11,6 +11,7 @@ mod mesh_files;
 mod movement;
 mod oracle;
 mod parry_support;
+mod scans;
 mod schedule;
 mod stress;
 mod teeth;

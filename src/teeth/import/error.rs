@@ -130,24 +130,10 @@ pub enum ImportError {
     },
     /// One large opening that does not face the root's side, so not a crown's margin.
     #[error(
-        "the mesh is open: an opening with a {length_mm:.2} mm boundary {at} is beyond the {max_hole_mm} mm closed automatically, and it does not face the root's side as a crown's margin does"
+        "the mesh is open: its longest opening, a {length_mm:.2} mm boundary {at}, is a crown's margin by its size (beyond {max_hole_mm} mm and the crown's width) but does not face the root's side: is the mesh upside down, or its transform wrong?"
     )]
     OpenNotMargin {
         /// Its boundary length.
-        length_mm: f32,
-        /// Where it is.
-        at: Near,
-        /// The longest boundary closed automatically.
-        max_hole_mm: f32,
-    },
-    /// Several large openings.
-    #[error(
-        "the mesh is open: {openings} openings, the smallest with a {length_mm:.2} mm boundary {at}, beyond the {max_hole_mm} mm closed automatically (a scanned crown has one opening, at the gum line)"
-    )]
-    Open {
-        /// Openings.
-        openings: usize,
-        /// The smallest one's boundary length.
         length_mm: f32,
         /// Where it is.
         at: Near,
@@ -158,7 +144,9 @@ pub enum ImportError {
     #[error("the cervical margin encloses no area: cannot generate a root")]
     FlatMargin,
     /// Two triangles cross.
-    #[error("the mesh intersects itself: triangles {a} and {b} cross {at}")]
+    #[error(
+        "the mesh intersects itself beyond what the repair cuts out: triangles {a} and {b} cross {at}"
+    )]
     SelfIntersecting {
         /// One triangle.
         a: usize,

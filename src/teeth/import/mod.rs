@@ -6,11 +6,15 @@
 //! orthosim's frame: millimetres, y towards the upper arch, z forwards (labial at the incisors), x
 //! towards the patient's left, the origin between the arches at the midline.
 //!
-//! Each mesh is checked and repaired ([`repair`]: welding, degenerate and duplicated triangles,
-//! winding, small holes, debris), and refused with the reason and a position when it cannot be
-//! (empty, NaN, non-manifold, open beyond the hole limit, several teeth in one file, self-
-//! intersecting). A scanned crown (one large opening, at the gum line) gets a generated root
-//! ([`root`]). The tooth's frame then comes from the mesh where the scan put it:
+//! Each mesh is checked and repaired as real scans need ([`repair`]: welding, degenerate and
+//! duplicated triangles, fins on non-manifold edges, bow-tie vertices, spikes, winding, loose
+//! pieces; then every hole closed but the cervical margin, and places where the surface meets
+//! itself cut out and closed again), and refused with the reason and a position only when it is
+//! not one tooth (empty, NaN, several large pieces, a twisted surface, wrong units, or a
+//! self-intersection that the repair cannot remove). A scanned crown (its longest opening is the
+//! gum line) gets a generated root that by construction meets neither the crown nor itself
+//! ([`root`]). Every repair is reported ([`Repairs`]). The tooth's frame then comes from the mesh
+//! where the scan put it:
 //!
 //! - long axis (local y): the principal axis of inertia closest to the arch's occlusal direction
 //!   (+y for the lower arch, −y for the upper), pointing occlusally;
@@ -22,8 +26,11 @@
 //! So loads, wire models, constraints and the analysis work on imported teeth as on procedural
 //! ones; the tooth stands exactly where the scan has it (its pose maps the local mesh back).
 
+mod close;
 mod error;
 mod export;
+mod fill;
+mod mend;
 mod read;
 pub mod repair;
 pub mod root;
@@ -40,7 +47,7 @@ use super::{
     fdi::{Arch, Fdi, ToothKind},
     tooth_shape::ToothGeometry,
 };
-use crate::geometry::{MassProperties, MeshError, Pose, TriMesh};
+use crate::geometry::{MassProperties, Pose, TriMesh};
 
 pub use error::{ImportError, Near, PlyProblem};
 pub use export::{ExportReport, export_case};
@@ -114,10 +121,10 @@ pub const MIN_SPAN_MM: f32 = 2.0;
 /// The largest extent of a tooth mesh (mm).
 pub const MAX_SPAN_MM: f32 = 80.0;
 
-/// A single large opening is taken for a crown's cervical margin (and closed by a generated root)
-/// only when the direction away from the crown through it is within 60° of the arch's apical
-/// direction.
-pub const MARGIN_COS: f32 = 0.5;
+/// The longest opening is taken for a crown's cervical margin (and closed by a generated root)
+/// only when the direction away from the crown through it is within 90° of the arch's apical
+/// direction (a scan's frame is rarely exact, so the test is loose).
+pub const MARGIN_COS: f32 = 0.0;
 
 /// An imported tooth: its geometry in its own frame and where the scan put it.
 #[derive(Debug)]
@@ -160,58 +167,19 @@ pub fn import_mesh(
     limits: &RepairLimits,
 ) -> Result<ImportedTooth, ImportError> {
     let an = anatomy(fdi.arch(), fdi.kind());
-    // (Non-finite coordinates are refused by the repair, naming the vertex.)
-    if !world.vertices.is_empty() && world.vertices.iter().all(|v| v.is_finite()) {
-        let span = world.aabb().extent().max_element();
-        if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
-            return Err(ImportError::Span {
-                span_mm: span,
-                min_mm: MIN_SPAN_MM,
-                max_mm: MAX_SPAN_MM,
-            });
-        }
-    }
     let mut repairs = Repairs::default();
-    let open = repair::clean(world, limits, &mut repairs)?;
-    let mut mesh = open.mesh;
-    let cervical = match open.loops.as_slice() {
-        [] => None,
-        [margin] => {
-            let length = repair::loop_length(&mesh, margin);
-            let (centre, apical) = root::close_with_root(&mut mesh, margin, an.root_length)?;
-            // A crown's margin faces away from the occlusal surface: any other large opening is a
-            // hole, not a missing root.
-            if apical.dot(-occlusal_direction(fdi.arch())) < MARGIN_COS {
-                return Err(ImportError::OpenNotMargin {
-                    length_mm: length,
-                    at: Near(mesh.vertices[margin[0] as usize]),
-                    max_hole_mm: limits.max_hole_mm,
-                });
-            }
-            repairs.root_generated_margin_mm = Some(length);
-            Some(centre)
-        }
-        loops => {
-            let (l, length) = loops
-                .iter()
-                .map(|l| (l, repair::loop_length(&mesh, l)))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .expect("several loops");
-            return Err(ImportError::Open {
-                openings: loops.len(),
-                length_mm: length,
-                at: Near(mesh.vertices[l[0] as usize]),
-                max_hole_mm: limits.max_hole_mm,
-            });
-        }
-    };
-    if mesh.signed_volume() < 0.0 {
-        for t in &mut mesh.triangles {
-            t.swap(1, 2);
-        }
-        repairs.turned_outward = true;
+    let crown = repair::clean(world, limits, &mut repairs)?;
+    // The span of the tooth itself, loose pieces dropped: wrong units show here.
+    let span = repair::used_span(&crown);
+    if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
+        return Err(ImportError::Span {
+            span_mm: span,
+            min_mm: MIN_SPAN_MM,
+            max_mm: MAX_SPAN_MM,
+        });
     }
-    mesh.validate_solid().map_err(|e| explain(&mesh, e))?;
+    let close::Closed { mesh, cervical } =
+        close::close(crown, fdi, an.root_length, limits, &mut repairs)?;
     let pose = tooth_pose(&mesh, fdi, curve, cervical, an.crown_length);
     let inverse = pose.inverse();
     let local = mesh.map_vertices(|v| inverse.transform_point(v));
@@ -221,24 +189,6 @@ pub fn import_mesh(
         pose,
         repairs,
     })
-}
-
-/// A mesh error with the place it is at.
-fn explain(mesh: &TriMesh, e: MeshError) -> ImportError {
-    let centre = |t: usize| {
-        let [a, b, c] = mesh.triangle(t);
-        (a + b + c) / 3.0
-    };
-    match e {
-        MeshError::SelfIntersecting { a, b } => ImportError::SelfIntersecting {
-            a,
-            b,
-            at: Near(centre(a)),
-        },
-        MeshError::Degenerate { triangle, .. } => ImportError::Degenerate(Near(centre(triangle))),
-        MeshError::Inverted { volume } => ImportError::Flat { volume },
-        other => ImportError::NotSolid(other),
-    }
 }
 
 /// The occlusal direction of an arch in orthosim's frame.

@@ -1,23 +1,26 @@
-//! Checking and repairing imported tooth meshes.
+//! Checking and cleaning imported tooth meshes.
 //!
 //! In order: refuse empty meshes, non-finite coordinates and bad indices; weld vertices closer
 //! than [`RepairLimits::weld_mm`]; drop degenerate triangles (a repeated vertex, or an area below
-//! 10⁻¹² of the squared mesh size) and duplicated triangles; refuse edges shared by more than two
-//! triangles; keep the largest connected piece when the others are debris (each under
-//! [`RepairLimits::debris_fraction`] of the triangles), refuse several pieces otherwise; make the
-//! winding consistent (flipping triangles to agree with their neighbours, refusing non-orientable
-//! surfaces); close holes whose boundary is at most [`RepairLimits::max_hole_mm`] long with a fan
-//! from the boundary's centroid; then either refuse a larger opening or, when allowed, treat the
-//! single large opening as the cervical margin of a scanned crown, closed by a generated root (see
-//! [`super::root`]); turn the surface outward (positive volume); and finally check the result is a
-//! closed, manifold surface that does not intersect itself ([`TriMesh::validate_solid`]).
+//! 10⁻¹² of the squared mesh size) and duplicated triangles; drop the triangles of edges shared by
+//! more than two (fins, [`super::mend`]); keep the largest connected piece when the others are
+//! debris (each under [`RepairLimits::debris_fraction`] of the triangles), refuse several pieces
+//! otherwise (more than one tooth); make the winding consistent (flipping triangles to agree with
+//! their neighbours, refusing non-orientable surfaces); give each fan of a bow-tie vertex its own
+//! vertex; and smooth spikes. Closing follows in [`super::close`]: every hole but the cervical
+//! margin is filled, the margin gets a generated root ([`super::root`]), the surface is turned
+//! outward, and places where it meets itself are cut out and closed again until the exact check
+//! ([`TriMesh::validate_solid`]) passes.
 
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use glam::{DVec3, IVec3, Vec3};
 use serde::Serialize;
 
-use super::error::{ImportError, Near};
+use super::{
+    error::{ImportError, Near},
+    mend,
+};
 use crate::geometry::TriMesh;
 
 /// Limits of what is repaired rather than refused.
@@ -25,10 +28,15 @@ use crate::geometry::TriMesh;
 pub struct RepairLimits {
     /// Vertices closer than this are one vertex (mm).
     pub weld_mm: f32,
-    /// Holes whose boundary is at most this long are closed (mm).
+    /// Openings whose boundary is at most this long (mm) are always holes, and closed. A longer
+    /// one is a crown's cervical margin when it is the longest and at least as long as the crown
+    /// is wide; every other opening is closed as a hole too.
     pub max_hole_mm: f32,
     /// Pieces with fewer than this fraction of the triangles are dropped as debris.
     pub debris_fraction: f32,
+    /// Self-intersecting patches are cut out and closed while the cuts remove at most this
+    /// fraction of the surface's triangles; beyond it the mesh is refused (it is not one tooth).
+    pub max_cut_fraction: f32,
 }
 
 impl Default for RepairLimits {
@@ -36,7 +44,8 @@ impl Default for RepairLimits {
         Self {
             weld_mm: 1e-5,
             max_hole_mm: 6.0,
-            debris_fraction: 0.05,
+            debris_fraction: 0.25,
+            max_cut_fraction: 0.3,
         }
     }
 }
@@ -52,6 +61,24 @@ pub struct Repairs {
     pub duplicate_triangles: usize,
     /// Small separate pieces dropped (and their triangles).
     pub debris_pieces: usize,
+    /// Triangles dropped from edges shared by more than two triangles (fins).
+    pub fin_triangles: usize,
+    /// Vertices split where separate fans of triangles met at one point.
+    pub split_vertices: usize,
+    /// Spike tips moved back onto the surface.
+    pub spikes_smoothed: usize,
+    /// Places where the surface met itself, cut out and closed again.
+    pub self_intersections_cut: usize,
+    /// Triangles removed by those cuts.
+    pub triangles_cut: usize,
+    /// Triangles removed where the cervical margin folded over itself (seen from the root's
+    /// side), so the generated root could hang straight from it.
+    pub margin_trimmed: usize,
+    /// Where the surface was changed (cuts, a folded margin's trim, split vertices, spikes):
+    /// centre (x, y, z, in the mesh's frame after units and transform) and radius (mm) of each
+    /// place. Elsewhere every vertex of the file is kept where it was; closing holes and the root
+    /// only add triangles.
+    pub changed_areas: Vec<[f32; 4]>,
     /// Triangles flipped to agree with their neighbours.
     pub flipped_triangles: usize,
     /// The whole surface faced inward and was turned.
@@ -81,6 +108,12 @@ impl Repairs {
         say(self.duplicate_triangles, "duplicated triangles dropped");
         say(self.debris_pieces, "loose pieces dropped");
         say(
+            self.fin_triangles,
+            "triangles dropped from non-manifold edges",
+        );
+        say(self.split_vertices, "non-manifold vertices split");
+        say(self.spikes_smoothed, "spikes smoothed");
+        say(
             self.flipped_triangles,
             "triangles flipped to a consistent winding",
         );
@@ -94,6 +127,18 @@ impl Repairs {
                 "{} holes closed (boundaries {} mm)",
                 self.holes_closed_mm.len(),
                 lengths.join(", ")
+            ));
+        }
+        if self.self_intersections_cut > 0 {
+            parts.push(format!(
+                "{} self-intersecting patches cut out and closed ({} triangles)",
+                self.self_intersections_cut, self.triangles_cut
+            ));
+        }
+        if self.margin_trimmed > 0 {
+            parts.push(format!(
+                "{} triangles trimmed where the margin folded",
+                self.margin_trimmed
             ));
         }
         if self.turned_outward {
@@ -110,21 +155,12 @@ impl Repairs {
     }
 }
 
-/// A surface with boundary loops still open after small holes were closed.
-#[derive(Clone, Debug)]
-pub(super) struct OpenSurface {
-    pub mesh: TriMesh,
-    /// Each remaining boundary loop: vertex indices in the direction the loop's edges run in their
-    /// triangles.
-    pub loops: Vec<Vec<u32>>,
-}
-
-/// Checks, welds, cleans, orients and closes small holes. Large openings are returned as loops.
+/// Checks, welds, cleans and orients; the result may still be open.
 pub(super) fn clean(
     mesh: &TriMesh,
     limits: &RepairLimits,
     repairs: &mut Repairs,
-) -> Result<OpenSurface, ImportError> {
+) -> Result<TriMesh, ImportError> {
     if mesh.vertices.is_empty() || mesh.triangles.is_empty() {
         return Err(ImportError::Empty {
             vertices: mesh.vertices.len(),
@@ -144,23 +180,18 @@ pub(super) fn clean(
             });
         }
     }
-    let (vertices, triangles) = weld(mesh, limits.weld_mm, repairs);
-    let triangles = drop_degenerate(&vertices, triangles, repairs);
+    let (mut vertices, triangles) = weld(mesh, limits.weld_mm, repairs);
+    let mut triangles = drop_degenerate(&vertices, triangles, repairs);
+    repairs.fin_triangles += mend::drop_fins(&mut triangles);
     let triangles = keep_main_piece(&vertices, triangles, limits, repairs)?;
-    let triangles = orient(&vertices, triangles, repairs)?;
-    let mut mesh = TriMesh::new(vertices, triangles);
-    let loops = boundary_loops(&mesh)?;
-    let mut open = Vec::new();
-    for l in loops {
-        let length = loop_length(&mesh, &l);
-        if length <= limits.max_hole_mm {
-            fill_hole(&mut mesh, &l);
-            repairs.holes_closed_mm.push(length);
-        } else {
-            open.push(l);
-        }
-    }
-    Ok(OpenSurface { mesh, loops: open })
+    let mut triangles = orient(&vertices, triangles, repairs)?;
+    let split = mend::split_bowties(&mut vertices, &mut triangles);
+    repairs.split_vertices += split.len();
+    repairs.changed_areas.extend(split);
+    let spikes = mend::smooth_spikes(&mut vertices, &triangles);
+    repairs.spikes_smoothed += spikes.len();
+    repairs.changed_areas.extend(spikes);
+    Ok(TriMesh::new(vertices, triangles))
 }
 
 /// Merges vertices within `tol` of each other (first come keeps its position) and drops the
@@ -279,7 +310,7 @@ fn edge_map(
     Ok(edges)
 }
 
-fn keep_main_piece(
+pub(super) fn keep_main_piece(
     vertices: &[Vec3],
     triangles: Vec<[u32; 3]>,
     limits: &RepairLimits,
@@ -328,6 +359,25 @@ fn keep_main_piece(
         });
     }
     repairs.debris_pieces += sizes.len() - 1;
+    // Each dropped piece's place: the centre of its vertices and the farthest one.
+    let mut sums = vec![(Vec3::ZERO, 0usize); sizes.len()];
+    for (t, &id) in triangles.iter().zip(&piece) {
+        for &v in t {
+            sums[id].0 += vertices[v as usize];
+            sums[id].1 += 1;
+        }
+    }
+    let mut reach = vec![0.0f32; sizes.len()];
+    for (t, &id) in triangles.iter().zip(&piece) {
+        let centre = sums[id].0 / sums[id].1 as f32;
+        for &v in t {
+            reach[id] = reach[id].max(vertices[v as usize].distance(centre));
+        }
+    }
+    for id in (0..sizes.len()).filter(|&i| i != main) {
+        let c = sums[id].0 / sums[id].1 as f32;
+        repairs.changed_areas.push([c.x, c.y, c.z, reach[id]]);
+    }
     Ok(triangles
         .into_iter()
         .enumerate()
@@ -392,7 +442,7 @@ fn orient(
 }
 
 /// Boundary loops of a consistently wound surface, each in its edges' direction.
-fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, ImportError> {
+pub(super) fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, ImportError> {
     let mut directed = HashSet::with_capacity(mesh.triangles.len() * 3);
     for t in &mesh.triangles {
         for k in 0..3 {
@@ -436,6 +486,18 @@ fn boundary_loops(mesh: &TriMesh) -> Result<Vec<Vec<u32>>, ImportError> {
     Ok(loops)
 }
 
+/// The largest extent (mm) of the vertices the triangles use.
+pub(super) fn used_span(mesh: &TriMesh) -> f32 {
+    crate::geometry::Aabb::from_points(
+        mesh.triangles
+            .iter()
+            .flatten()
+            .map(|&v| mesh.vertices[v as usize]),
+    )
+    .extent()
+    .max_element()
+}
+
 pub(super) fn loop_length(mesh: &TriMesh, l: &[u32]) -> f32 {
     (0..l.len())
         .map(|i| {
@@ -459,19 +521,5 @@ pub(super) fn loop_centroid(mesh: &TriMesh, l: &[u32]) -> Vec3 {
         (sum / total).as_vec3()
     } else {
         mesh.vertices[l[0] as usize]
-    }
-}
-
-/// Closes a hole with a fan from its centroid, wound to match the surrounding triangles.
-fn fill_hole(mesh: &mut TriMesh, l: &[u32]) {
-    if l.len() == 3 {
-        mesh.triangles.push([l[2], l[1], l[0]]);
-        return;
-    }
-    let c = mesh.vertices.len() as u32;
-    mesh.vertices.push(loop_centroid(mesh, l));
-    for i in 0..l.len() {
-        let (a, b) = (l[i], l[(i + 1) % l.len()]);
-        mesh.triangles.push([b, a, c]);
     }
 }
