@@ -247,3 +247,41 @@ fn scan_resolution_crowns_with_defects_import() {
         assert!(drift <= 0.01, "{n}: {drift}");
     }
 }
+
+#[test]
+fn heavily_damaged_crowns_never_panic_and_import_as_solids_or_are_refused() {
+    let d = normal();
+    let limits = RepairLimits::default();
+    let mut imported = 0;
+    for seed in 0..40u64 {
+        let fdi = Fdi::all().nth((seed * 7 % 32) as usize).unwrap();
+        let tooth = d.tooth(fdi).unwrap();
+        // Up to five of each defect, far beyond what scans have.
+        let base = ScanDefects::typical(seed);
+        let many = |n: usize| n * 2 + (seed % 2) as usize;
+        let defects = ScanDefects {
+            holes: many(base.holes),
+            spikes: many(base.spikes),
+            bowties: many(base.bowties),
+            fins: many(base.fins),
+            folds: many(base.folds),
+            debris: many(base.debris),
+            ..base
+        };
+        let triangles = 300 + (seed as usize * 397) % 2500;
+        let scan = scan_like_crown(
+            fdi.arch(),
+            fdi.kind(),
+            &tooth.pose,
+            triangles,
+            &defects,
+            seed,
+        );
+        if let Ok(t) = import_mesh(&scan.mesh, fdi, &curve(&d, fdi), &limits) {
+            t.geometry.mesh.validate_solid().unwrap();
+            imported += 1;
+        }
+    }
+    println!("{imported} of 40 heavily damaged crowns imported");
+    assert!(imported >= 30, "{imported}");
+}
