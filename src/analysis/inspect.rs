@@ -7,8 +7,9 @@
 use serde::Serialize;
 
 use crate::{
+    analysis::occlusion::{MeasuredOcclusion, measure_occlusion},
     geometry::{MeshError, TriMesh, mesh_separation},
-    teeth::{Dentition, PlacedTooth, arch::OcclusionMeasures},
+    teeth::{Dentition, PlacedTooth},
 };
 
 /// One tooth's line of the report.
@@ -67,8 +68,8 @@ pub struct InspectReport {
     pub occlusal_max_penetration_mm: f32,
     /// Least gap between the arches (mm; negative when they overlap).
     pub occlusal_min_gap_mm: f32,
-    /// Overjet, overbite and molar relation of the underlying arrangement.
-    pub occlusion: OcclusionMeasures,
+    /// Overjet, overbite and molar relation measured on the teeth present, where they stand.
+    pub occlusion: MeasuredOcclusion,
     /// Teeth read from mesh files, with what was repaired in each.
     pub imported: Vec<ImportedMesh>,
 }
@@ -168,7 +169,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
         max_penetration_mm: same_arch,
         occlusal_max_penetration_mm: occlusal,
         occlusal_min_gap_mm: occlusal_gap,
-        occlusion: d.arrangement,
+        occlusion: measure_occlusion(d),
         imported: d
             .imported
             .iter()

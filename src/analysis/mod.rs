@@ -1,11 +1,13 @@
 //! Analysis: measures computed from placed teeth (no ECS needed), and the report.
 //!
 //! [`inspect`](mod@inspect) (mesh data and gaps of a case as loaded), [`measures`] (distances,
-//! occlusal contacts, IPR limits, Bolton and arch length), [`plot`] (the paper's distance figures)
+//! occlusal contacts, IPR limits, Bolton and arch length), [`occlusion`] (overjet, overbite and
+//! molar relation of the teeth present), [`plot`] (the paper's distance figures)
 //! and [`report`] (`orthosim report`: every case under every method, to JSON, CSV, plots and HTML).
 
 pub mod inspect;
 pub mod measures;
+pub mod occlusion;
 pub mod plot;
 pub mod report;
 
@@ -16,6 +18,7 @@ use crate::{
 };
 
 pub use inspect::{InspectReport, inspect};
+pub use occlusion::{MeasuredOcclusion, measure_occlusion};
 pub use report::{ALL_CASES, ReportOptions, Summary, run_report};
 
 /// Why a report could not be made or written.

@@ -93,9 +93,19 @@ fn print_table(report: &InspectReport) {
         "max penetration between arches: {:.4} mm (least gap {:.4} mm)",
         report.occlusal_max_penetration_mm, report.occlusal_min_gap_mm
     );
-    let o = report.occlusion;
+    let o = &report.occlusion;
+    let show = |v: Option<f32>, sign: bool| match v {
+        Some(v) if sign => format!("{v:+.2} mm"),
+        Some(v) => format!("{v:.2} mm"),
+        None => "not measured".into(),
+    };
     println!(
-        "overjet {:.2} mm, overbite {:.2} mm, molar relation {:+.2} mm (0 = class I)",
-        o.overjet_mm, o.overbite_mm, o.molar_relation_mm
+        "overjet {}, overbite {}, molar relation {} (0 = class I)",
+        show(o.overjet_mm, false),
+        show(o.overbite_mm, false),
+        show(o.molar_relation_mm, true)
     );
+    for (what, why) in &o.unmeasured {
+        println!("  {what}: {why}");
+    }
 }

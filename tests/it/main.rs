@@ -9,6 +9,7 @@ mod import;
 mod layers;
 mod mesh_files;
 mod movement;
+mod occlusion_measures;
 mod oracle;
 mod parry_support;
 mod scans;

@@ -225,7 +225,7 @@ fn near_points(crown: &TriMesh, points: &[Vec3], edges: f32, min_mm: f32) -> Has
         (-1..=1).any(|dx| {
             (-1..=1).any(|dy| {
                 (-1..=1).any(|dz| {
-                    grid.get(&(k + IVec3::new(dx, dy, dz)))
+                    grid.get(&k.saturating_add(IVec3::new(dx, dy, dz)))
                         .is_some_and(|l| l.iter().any(|s| s.distance(p) <= radius))
                 })
             })

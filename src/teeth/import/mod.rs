@@ -118,8 +118,10 @@ pub struct ToothMeshFile {
 
 /// The least extent of a tooth mesh (mm): smaller ones are refused (wrong units, or not a tooth).
 pub const MIN_SPAN_MM: f32 = 2.0;
-/// The largest extent of a tooth mesh (mm).
+/// The largest extent of a tooth mesh (mm), loose pieces dropped.
 pub const MAX_SPAN_MM: f32 = 80.0;
+/// A file spanning more than this (mm), loose pieces included, is refused before any repair.
+pub const ABSURD_SPAN_MM: f32 = 10_000.0;
 
 /// The longest opening is taken for a crown's cervical margin (and closed by a generated root)
 /// only when the direction away from the crown through it is within 90° of the arch's apical
@@ -167,6 +169,17 @@ pub fn import_mesh(
     limits: &RepairLimits,
 ) -> Result<ImportedTooth, ImportError> {
     let an = anatomy(fdi.arch(), fdi.kind());
+    // Absurd sizes (far beyond any unit mix-up with debris) are refused before any repair.
+    if world.vertices.iter().all(|v| v.is_finite()) && !world.vertices.is_empty() {
+        let span = world.aabb().extent().max_element();
+        if span > ABSURD_SPAN_MM {
+            return Err(ImportError::Span {
+                span_mm: span,
+                min_mm: MIN_SPAN_MM,
+                max_mm: MAX_SPAN_MM,
+            });
+        }
+    }
     let mut repairs = Repairs::default();
     let crown = repair::clean(world, limits, &mut repairs)?;
     // The span of the tooth itself, loose pieces dropped: wrong units show here.

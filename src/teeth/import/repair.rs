@@ -217,7 +217,7 @@ fn weld(mesh: &TriMesh, tol: f32, repairs: &mut Repairs) -> (Vec<Vec3>, Vec<[u32
         'search: for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    if let Some(list) = grid.get(&(k + IVec3::new(dx, dy, dz))) {
+                    if let Some(list) = grid.get(&k.saturating_add(IVec3::new(dx, dy, dz))) {
                         for &j in list {
                             if vertices[j as usize].distance(v) <= tol {
                                 found = Some(j);
