@@ -4,7 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use orthosim::teeth::{Case, Dentition, import::export_case};
+use orthosim::teeth::{
+    Case, Dentition,
+    import::{ExportMeshes, export_case_as},
+};
 
 /// `export-case`'s arguments.
 #[derive(Args, Debug)]
@@ -15,12 +18,27 @@ pub struct ExportCaseArgs {
     /// Folder to write into (created if needed).
     #[arg(long)]
     pub out: PathBuf,
+    /// Write each tooth as a scan-like crown of about this many triangles (open at a scalloped
+    /// gum line, with holes, spikes, non-manifold spots, folds and debris as real scans have), to
+    /// try the import of scanned crowns; the case then gets generated roots.
+    #[arg(long, value_name = "TRIANGLES", value_parser = clap::value_parser!(u32).range(100..=200_000))]
+    pub scan_like: Option<u32>,
+    /// Seed of the scan-like defects.
+    #[arg(long, default_value_t = 1, requires = "scan_like")]
+    pub seed: u64,
 }
 
 /// Exports the case (every output is checked before any is written).
 pub fn run(args: ExportCaseArgs) -> Result<()> {
     let d = Dentition::build(Case::resolve(&args.case)?)?;
-    let report = export_case(&d, &args.out)?;
+    let meshes = match args.scan_like {
+        Some(triangles) => ExportMeshes::ScanLike {
+            triangles: triangles as usize,
+            seed: args.seed,
+        },
+        None => ExportMeshes::Teeth,
+    };
+    let report = export_case_as(&d, &args.out, meshes)?;
     println!(
         "wrote {} ({} teeth, {} triangles)",
         report.case_file.display(),

@@ -672,3 +672,67 @@ fn a_refused_export_writes_nothing() {
     assert!(!fresh.exists(), "a refused export created its folder");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_scan_like_export_imports_and_runs_through_inspect_trees_and_simulate() {
+    let dir = fresh_dir("scan-like");
+    succeed(&[
+        "export-case",
+        "--case",
+        "case1",
+        "--scan-like",
+        "1500",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let case = dir.join("case1.ron");
+    let case = case.to_str().unwrap();
+    let report = json_of(&["inspect", "--case", case, "--json"]);
+    let imported = report["imported"].as_array().unwrap();
+    assert_eq!(imported.len(), 32);
+    for m in imported {
+        assert!(m["repairs"]["root_generated_margin_mm"].is_number(), "{m}");
+    }
+    for t in report["teeth"].as_array().unwrap() {
+        assert_eq!(t["closed"], true, "{t}");
+    }
+    // The occlusion is measured on the scanned teeth.
+    assert!(report["occlusion"]["molar_relation_mm"].is_number());
+    let trees = json_of(&["trees", "--case", case, "--method", "octree", "--json"]);
+    assert_eq!(
+        trees["summary"]["all_covered"], true,
+        "{}",
+        trees["summary"]
+    );
+    let sim = json_of(&[
+        "simulate",
+        "--case",
+        case,
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--max-steps",
+        "300",
+        "--json",
+    ]);
+    // The same teeth move as in the built-in case, and no deeper into their neighbours than the
+    // scanned teeth already were (generated roots of neighbours can start overlapping).
+    let built_in = json_of(&[
+        "simulate",
+        "--case",
+        "case1",
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--max-steps",
+        "300",
+        "--json",
+    ]);
+    assert_eq!(sim["moved"], built_in["moved"], "{sim}");
+    let start = report["max_penetration_mm"].as_f64().unwrap();
+    let end = sim["max_penetration_mm"].as_f64().unwrap();
+    assert!(
+        end <= start + 0.05,
+        "{start} mm at the start, {end} mm after"
+    );
+}

@@ -12,6 +12,7 @@ use crate::{
     teeth::{
         Dentition,
         case::{Case, ToothMap},
+        scan_like::{ScanDefects, scan_like_crown},
     },
 };
 
@@ -26,6 +27,22 @@ pub struct ExportReport {
     pub triangles: usize,
 }
 
+/// What `export-case` writes for each tooth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ExportMeshes {
+    /// The tooth's closed mesh, as the case has it.
+    Teeth,
+    /// A scan-like crown of the tooth's type where the tooth stands ([`scan_like_crown`]): open
+    /// at a scalloped gum line, about `triangles` triangles, with the defects real scans have
+    /// (drawn from `seed` and the tooth's number), for trying the import of scanned crowns.
+    ScanLike {
+        /// Triangles per crown (about).
+        triangles: usize,
+        /// Seed of the defects.
+        seed: u64,
+    },
+}
+
 /// Writes the teeth of `d` to `dir` (created if needed) as `NN.stl` and the case as `NAME.ron`,
 /// all or nothing: every output is checked (name and path lengths, never the case file `d` was
 /// read from or one of its mesh files) before any is written, each is written to a temporary file
@@ -34,6 +51,18 @@ pub struct ExportReport {
 /// # Errors
 /// The first output that cannot or must not be written ([`OutputError`]).
 pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, OutputError> {
+    export_case_as(d, dir, ExportMeshes::Teeth)
+}
+
+/// [`export_case`] writing `meshes` for each tooth.
+///
+/// # Errors
+/// The first output that cannot or must not be written ([`OutputError`]).
+pub fn export_case_as(
+    d: &Dentition,
+    dir: &Path,
+    meshes_as: ExportMeshes,
+) -> Result<ExportReport, OutputError> {
     let source = Path::new(&d.case.origin);
     let mut case: Case = d.case.case.clone();
     let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
@@ -57,7 +86,23 @@ pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, OutputErro
     let mut files = ToothMap::default();
     let mut triangles = 0;
     for (t, path) in d.teeth.iter().zip(&meshes) {
-        let world = t.geometry.mesh.map_vertices(|v| t.pose.transform_point(v));
+        let world = match meshes_as {
+            ExportMeshes::Teeth => t.geometry.mesh.map_vertices(|v| t.pose.transform_point(v)),
+            ExportMeshes::ScanLike { triangles, seed } => {
+                let seed = seed
+                    .wrapping_mul(100)
+                    .wrapping_add(u64::from(t.fdi.number()));
+                scan_like_crown(
+                    t.fdi.arch(),
+                    t.fdi.kind(),
+                    &t.pose,
+                    triangles,
+                    &ScanDefects::typical(seed),
+                    seed,
+                )
+                .mesh
+            }
+        };
         let mut bytes = Vec::new();
         write_stl(&world, &mut bytes).map_err(|source| OutputError::Write {
             path: path.clone(),
@@ -84,8 +129,14 @@ pub fn export_case(d: &Dentition, dir: &Path) -> Result<ExportReport, OutputErro
                 path: case_file.clone(),
                 source: std::io::Error::other(e),
             })?;
+    let what = match meshes_as {
+        ExportMeshes::Teeth => "one STL per tooth".to_string(),
+        ExportMeshes::ScanLike { triangles, seed } => format!(
+            "one scan-like crown per tooth (about {triangles} triangles, defects of seed {seed})"
+        ),
+    };
     let header = format!(
-        "// Exported by `orthosim export-case` from {}: one STL per tooth (mm, orthosim's frame,\n\
+        "// Exported by `orthosim export-case` from {}: {what} (mm, orthosim's frame,\n\
          // where the case placed it), so offsets and the bite opening are part of the meshes.\n",
         d.case.origin
     );

@@ -50,7 +50,7 @@ use super::{
 use crate::geometry::{MassProperties, Pose, TriMesh};
 
 pub use error::{ImportError, Near, PlyProblem};
-pub use export::{ExportReport, export_case};
+pub use export::{ExportMeshes, ExportReport, export_case, export_case_as};
 pub use read::{MeshFormat, read_mesh, write_stl};
 pub use repair::{RepairLimits, Repairs};
 

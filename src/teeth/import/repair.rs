@@ -45,7 +45,7 @@ impl Default for RepairLimits {
             weld_mm: 1e-5,
             max_hole_mm: 6.0,
             debris_fraction: 0.25,
-            max_cut_fraction: 0.3,
+            max_cut_fraction: 0.5,
         }
     }
 }
