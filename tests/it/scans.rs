@@ -285,3 +285,33 @@ fn heavily_damaged_crowns_never_panic_and_import_as_solids_or_are_refused() {
     println!("{imported} of 40 heavily damaged crowns imported");
     assert!(imported >= 30, "{imported}");
 }
+
+#[test]
+fn scanned_crowns_get_full_medial_trees() {
+    use orthosim::sphere_tree::{
+        TreeMethod, TreeSettings, check_coverage, coverage::DEFAULT_SPLIT_DEPTH,
+    };
+    let d = normal();
+    // A symmetric crown's root used to lie exactly along its long axis, and the medial builder
+    // then returned a single sphere.
+    for n in [11, 13, 16, 36, 43] {
+        let fdi = Fdi::new(n).unwrap();
+        let tooth = d.tooth(fdi).unwrap();
+        let scan = scan_like_crown(
+            fdi.arch(),
+            fdi.kind(),
+            &tooth.pose,
+            2000,
+            &ScanDefects::CLEAN,
+            7,
+        );
+        let t = import_mesh(&scan.mesh, fdi, &curve(&d, fdi), &RepairLimits::default()).unwrap();
+        let g = &t.geometry;
+        let tree = TreeSettings::with_method(TreeMethod::Medial)
+            .build(&g.mesh, &g.bvh)
+            .unwrap();
+        let leaves = tree.leaves().count();
+        assert!(leaves >= 300, "{n}: {leaves} leaves");
+        assert!(check_coverage(&tree, &g.mesh, DEFAULT_SPLIT_DEPTH).covered);
+    }
+}

@@ -5,7 +5,7 @@
 //! stand-in root of the anatomy table's length, documented as such in the import report.
 //!
 //! Construction. Let `a` be the margin's apical direction (its Newell normal, turned away from the
-//! crown) and `h0` a plane across `a` just beyond every vertex of the crown ([`GAPS_MM`] beyond
+//! crown, then leaning [`LEAN_RAD`] aside) and `h0` a plane across `a` just beyond every vertex of the crown ([`GAPS_MM`] beyond
 //! the deepest one). The margin is projected along `a` onto that plane, giving the polygon `Q`:
 //!
 //! - **Collar.** Each margin edge is joined to its projection: a vertical strip. When `Q` is a
@@ -48,6 +48,11 @@ pub const GAPS_MM: [f32; 3] = [0.3, 1.0, 2.5];
 /// Least distance (mm) between non-adjacent edges of the projected margin for the collar to be
 /// vertical strips.
 pub const MIN_SEPARATION_MM: f64 = 2e-3;
+/// The root leans this much (radians, about 3°) off the margin's normal. Its collar is then never
+/// parallel to the tooth's long axis (the principal axis of the closed tooth, which for a
+/// symmetric crown is the margin's normal to the last digit): the medial sphere-tree builder's
+/// lattice lines run along that axis and lose the inside of surfaces exactly parallel to them.
+pub const LEAN_RAD: f64 = 0.05;
 /// Rounds of local smoothing that may make a tangled projected margin simple.
 pub const UNTANGLE_ROUNDS: usize = 40;
 /// Half-width (vertices) of the window over which a star-shaped collar's radii are averaged.
@@ -113,7 +118,7 @@ pub fn close_with_root(
     gap: f32,
 ) -> Result<(Vec3, Vec3), ImportError> {
     let (centre, apical) = margin_axis(mesh, l)?;
-    let (c, a) = (centre.as_dvec3(), apical.as_dvec3());
+    let (c, a) = (centre.as_dvec3(), leaning(apical));
     let u = a.any_orthonormal_vector();
     let w = a.cross(u);
     let deepest = mesh
@@ -167,12 +172,18 @@ fn project(mesh: &TriMesh, l: &[u32], c: DVec3, u: DVec3, w: DVec3) -> Vec<DVec2
 /// [`ImportError::FlatMargin`] when the margin encloses no area.
 pub fn tangles(mesh: &TriMesh, l: &[u32]) -> Result<Vec<usize>, ImportError> {
     let (centre, apical) = margin_axis(mesh, l)?;
-    let a = apical.as_dvec3();
+    let a = leaning(apical);
     let u = a.any_orthonormal_vector();
     Ok(offending(
         &project(mesh, l, centre.as_dvec3(), u, a.cross(u)),
         MIN_SEPARATION_MM,
     ))
+}
+
+/// The direction the root is built along: the apical direction turned by [`LEAN_RAD`].
+fn leaning(apical: Vec3) -> DVec3 {
+    let a = apical.as_dvec3();
+    (a + a.any_orthonormal_vector() * LEAN_RAD.tan()).normalize()
 }
 
 /// Quads between two rings of equal size: `upper` runs in its triangles' edge direction, so the
