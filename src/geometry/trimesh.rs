@@ -341,6 +341,26 @@ impl TriMesh {
             .collect()
     }
 
+    /// The same surface without the vertices no triangle uses (the rest keep their order).
+    pub fn without_unused_vertices(&self) -> Self {
+        let mut map = vec![u32::MAX; self.vertices.len()];
+        let mut vertices = Vec::with_capacity(self.vertices.len());
+        let triangles = self
+            .triangles
+            .iter()
+            .map(|t| {
+                t.map(|v| {
+                    if map[v as usize] == u32::MAX {
+                        map[v as usize] = vertices.len() as u32;
+                        vertices.push(self.vertices[v as usize]);
+                    }
+                    map[v as usize]
+                })
+            })
+            .collect();
+        Self::new(vertices, triangles)
+    }
+
     /// A copy with every vertex mapped by `f` (e.g. a pose).
     pub fn map_vertices(&self, f: impl Fn(Vec3) -> Vec3) -> Self {
         Self::new(

@@ -110,7 +110,7 @@ pub fn scan_like_crown(
     }
     let jitter = mean_edge(&mesh).min(0.2);
     cut_at_gum_line(&mut mesh, defects.scallop_mm, jitter, &mut rng);
-    let mut mesh = compact(largest_piece(mesh));
+    let mut mesh = largest_piece(mesh).without_unused_vertices();
     let reference = mesh.clone();
     let mut sites: Vec<(Vec3, f32)> = Vec::new();
     let mut placed = ScanDefects {
@@ -283,25 +283,6 @@ fn largest_piece(mesh: TriMesh) -> TriMesh {
         .map(|(_, t)| *t)
         .collect();
     TriMesh::new(mesh.vertices, triangles)
-}
-
-fn compact(mesh: TriMesh) -> TriMesh {
-    let mut map = vec![u32::MAX; mesh.vertices.len()];
-    let mut vertices = Vec::new();
-    let triangles = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                if map[v as usize] == u32::MAX {
-                    map[v as usize] = vertices.len() as u32;
-                    vertices.push(mesh.vertices[v as usize]);
-                }
-                map[v as usize]
-            })
-        })
-        .collect();
-    TriMesh::new(vertices, triangles)
 }
 
 fn mean_edge(mesh: &TriMesh) -> f32 {

@@ -133,7 +133,7 @@ pub(super) fn close(
                 repairs.holes_closed_mm.extend(holes);
                 repairs.root_generated_margin_mm = margin.map(|m| lengths[m]);
                 return Ok(Closed {
-                    mesh: compact(mesh),
+                    mesh: mesh.without_unused_vertices(),
                     cervical,
                 });
             }
@@ -275,26 +275,6 @@ fn areas(crown: &TriMesh, cut: &HashSet<usize>) -> Vec<[f32; 4]> {
         out.push([centre.x, centre.y, centre.z, radius]);
     }
     out
-}
-
-/// Drops vertices no triangle uses.
-fn compact(mesh: TriMesh) -> TriMesh {
-    let mut map = vec![u32::MAX; mesh.vertices.len()];
-    let mut vertices = Vec::with_capacity(mesh.vertices.len());
-    let triangles = mesh
-        .triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                if map[v as usize] == u32::MAX {
-                    map[v as usize] = vertices.len() as u32;
-                    vertices.push(mesh.vertices[v as usize]);
-                }
-                map[v as usize]
-            })
-        })
-        .collect();
-    TriMesh::new(vertices, triangles)
 }
 
 /// A mesh error with the place it is at.
