@@ -91,7 +91,7 @@ pub(super) fn close(
         if let Some(m) = margin
             && trims < MAX_TRIMS
         {
-            let at: HashSet<u32> = root::tangles(&base, &loops[m])?
+            let at: HashSet<u32> = root::tangles(&base, &loops[m], root_length)?
                 .into_iter()
                 .map(|k| loops[m][k])
                 .collect();

@@ -5,19 +5,21 @@
 //! stand-in root of the anatomy table's length, documented as such in the import report.
 //!
 //! Construction. Let `a` be the margin's apical direction (its Newell normal, turned away from the
-//! crown, then leaning [`LEAN_RAD`] aside) and `h0` a plane across `a` just beyond every vertex of the crown ([`GAPS_MM`] beyond
-//! the deepest one). The margin is projected along `a` onto that plane, giving the polygon `Q`:
+//! crown, then leaning [`LEAN_RAD`] aside) and `h0` a plane across `a` just beyond every vertex of
+//! the crown ([`GAPS_MM`] beyond the deepest one):
 //!
-//! - **Collar.** Each margin edge is joined to its projection: a vertical strip. When `Q` is a
-//!   simple polygon (no two edges closer than [`MIN_SEPARATION_MM`]), the strips meet only along
-//!   shared edges, because their cross-section at every depth is a part of `Q`. A jagged margin on
-//!   a steep wall folds over itself in projection; the import first trims the crown's triangles at
-//!   the folds ([`tangles`] says where; `close` does the trimming). Folds that remain are smoothed
-//!   out of `Q` locally (only the vertices at a fold move, towards their neighbours), or, failing
-//!   that, `Q` becomes a star-shaped polygon with one vertex per margin vertex (strictly
-//!   increasing angles about the margin's centre, radii averaged over [`SMOOTH`] neighbours),
-//!   simple by construction. Where `Q` was moved the strips lean a little, and the exact check
-//!   after closing verifies them.
+//! - **Collar.** Each margin vertex is joined to where the ray from it to the *focus* (a point on
+//!   the axis one root length beyond the crown's deepest vertex) meets that plane; the strips
+//!   between neighbouring rays are planar quads through the focus. When the margin seen from the
+//!   focus (its central projection `Q`) is a simple polygon (no two edges closer than
+//!   [`MIN_SEPARATION_MM`]), the strips meet only along shared edges, because their cross-section
+//!   at every depth is a part of a scaled copy of `Q`. A jagged margin on a steep wall folds over
+//!   itself in projection; the import first trims the crown's triangles at the folds ([`tangles`]
+//!   says where; `close` does the trimming). Folds that remain are smoothed out of `Q` locally
+//!   (only the vertices at a fold move, towards their neighbours), or, failing that, `Q` becomes a
+//!   star-shaped polygon with one vertex per margin vertex (strictly increasing angles about the
+//!   margin's centre, radii averaged over [`SMOOTH`] neighbours), simple by construction. Where `Q`
+//!   was moved the strips lean a little, and the exact check after closing verifies them.
 //! - **Body.** Rings below the plane are copies of `Q` scaled about one point by `(1 − t)^0.7`
 //!   at depths growing linearly towards the apex, closed by a cone to the apex. Two consecutive
 //!   rings are related by a homothety, so each band between them is a frustum of a cone: its quads
@@ -118,18 +120,15 @@ pub fn close_with_root(
     gap: f32,
 ) -> Result<(Vec3, Vec3), ImportError> {
     let (centre, apical) = margin_axis(mesh, l)?;
-    let (c, a) = (centre.as_dvec3(), leaning(apical));
-    let u = a.any_orthonormal_vector();
-    let w = a.cross(u);
-    let deepest = mesh
-        .vertices
-        .iter()
-        .map(|v| (v.as_dvec3() - c).dot(a))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let h0 = deepest + f64::from(gap);
+    let f = Focus::new(mesh, centre, apical, root_length);
+    let (c, a, u, w) = (f.c, f.a, f.u, f.w);
+    let h0 = f.deepest + f64::from(gap);
     let apex_depth = f64::from(root_length).max(h0 + 0.3 * f64::from(root_length));
-    let projected = project(mesh, l, c, u, w);
-    let ring0 = untangle(&projected, MIN_SEPARATION_MM).unwrap_or_else(|| star(&projected));
+    let projected = f.project(mesh, l);
+    let outline = untangle(&projected, MIN_SEPARATION_MM).unwrap_or_else(|| star(&projected));
+    // The collar's strips run from each margin vertex towards the focus, to the plane at h0.
+    let to_h0 = (f.depth - h0) / (f.depth - f.deepest);
+    let ring0: Vec<DVec2> = outline.iter().map(|&q| q * to_h0).collect();
     let pivot = area_centroid(&ring0);
     let place = |q: DVec2, depth: f64| (c + a * depth + u * q.x + w * q.y).as_vec3();
     let mut prev: Vec<u32> = l.to_vec();
@@ -155,29 +154,62 @@ pub fn close_with_root(
     Ok((centre, apical))
 }
 
-/// The margin's vertices projected along the apical direction onto the plane of `u` and `w`.
-fn project(mesh: &TriMesh, l: &[u32], c: DVec3, u: DVec3, w: DVec3) -> Vec<DVec2> {
-    l.iter()
-        .map(|&i| {
-            let d = mesh.vertices[i as usize].as_dvec3() - c;
-            DVec2::new(d.dot(u), d.dot(w))
-        })
-        .collect()
+/// Where the collar's strips converge: a point on the root's axis one root length beyond the
+/// crown's deepest vertex, and the frame the margin is projected in.
+struct Focus {
+    c: DVec3,
+    a: DVec3,
+    u: DVec3,
+    w: DVec3,
+    /// Depth (along `a`, from `c`) of the crown's deepest vertex.
+    deepest: f64,
+    /// Depth of the focus.
+    depth: f64,
 }
 
-/// Positions in `l` of the margin vertices where the margin, seen along its apical direction,
-/// folds, crosses or nearly touches itself (empty when the collar can be vertical strips).
+impl Focus {
+    fn new(mesh: &TriMesh, centre: Vec3, apical: Vec3, root_length: f32) -> Self {
+        let (c, a) = (centre.as_dvec3(), leaning(apical));
+        let u = a.any_orthonormal_vector();
+        let w = a.cross(u);
+        let deepest = mesh
+            .vertices
+            .iter()
+            .map(|v| (v.as_dvec3() - c).dot(a))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let depth = deepest + f64::from(root_length).max(GAPS_MM[GAPS_MM.len() - 1] as f64 + 1.0);
+        Self {
+            c,
+            a,
+            u,
+            w,
+            deepest,
+            depth,
+        }
+    }
+
+    /// The margin's vertices projected from the focus onto the plane through the crown's deepest
+    /// vertex, in the coordinates of `u` and `w`.
+    fn project(&self, mesh: &TriMesh, l: &[u32]) -> Vec<DVec2> {
+        l.iter()
+            .map(|&i| {
+                let d = mesh.vertices[i as usize].as_dvec3() - self.c;
+                let scale = (self.depth - self.deepest) / (self.depth - d.dot(self.a));
+                DVec2::new(d.dot(self.u), d.dot(self.w)) * scale
+            })
+            .collect()
+    }
+}
+
+/// Positions in `l` of the margin vertices where the margin, seen from the root's focus, folds,
+/// crosses or nearly touches itself (empty when the collar's strips can all point at the focus).
 ///
 /// # Errors
 /// [`ImportError::FlatMargin`] when the margin encloses no area.
-pub fn tangles(mesh: &TriMesh, l: &[u32]) -> Result<Vec<usize>, ImportError> {
+pub fn tangles(mesh: &TriMesh, l: &[u32], root_length: f32) -> Result<Vec<usize>, ImportError> {
     let (centre, apical) = margin_axis(mesh, l)?;
-    let a = leaning(apical);
-    let u = a.any_orthonormal_vector();
-    Ok(offending(
-        &project(mesh, l, centre.as_dvec3(), u, a.cross(u)),
-        MIN_SEPARATION_MM,
-    ))
+    let f = Focus::new(mesh, centre, apical, root_length);
+    Ok(offending(&f.project(mesh, l), MIN_SEPARATION_MM))
 }
 
 /// The direction the root is built along: the apical direction turned by [`LEAN_RAD`].
