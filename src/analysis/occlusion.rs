@@ -10,10 +10,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::geometry::Pose;
 use crate::teeth::{
     Dentition, Fdi, PlacedTooth,
-    arch::{incisor_relation, molar_relation},
+    arch::{Placed, incisor_relation, molar_relation},
 };
 
 /// The occlusion measures of a dentition (mm).
@@ -38,8 +37,8 @@ pub fn measure_occlusion(d: &Dentition) -> MeasuredOcclusion {
         d.tooth(Fdi::new(i64::from(n)).ok()?)
             .filter(|t| !t.extracted)
     };
-    fn placed(t: &PlacedTooth) -> (&crate::teeth::ToothGeometry, Pose) {
-        (t.geometry.as_ref(), t.pose)
+    fn placed(t: &PlacedTooth) -> Placed<'_> {
+        (t.geometry.as_ref(), &t.pose)
     }
     let mut jets = Vec::new();
     let mut bites = Vec::new();
@@ -50,8 +49,7 @@ pub fn measure_occlusion(d: &Dentition) -> MeasuredOcclusion {
     for (ui, li, um, lm) in [(11u8, 41u8, 16u8, 46u8), (21, 31, 26, 36)] {
         match (present(ui), present(li)) {
             (Some(u), Some(l)) => {
-                let (pu, pl) = (placed(u), placed(l));
-                let (jet, bite) = incisor_relation((pu.0, &pu.1), (pl.0, &pl.1));
+                let (jet, bite) = incisor_relation(placed(u), placed(l));
                 bites.push(bite);
                 match jet {
                     Some(j) => jets.push(j),
@@ -67,8 +65,7 @@ pub fn measure_occlusion(d: &Dentition) -> MeasuredOcclusion {
         }
         match (present(um), present(lm)) {
             (Some(u), Some(l)) => {
-                let (pu, pl) = (placed(u), placed(l));
-                molars.push(molar_relation((pu.0, &pu.1), (pl.0, &pl.1)));
+                molars.push(molar_relation(placed(u), placed(l)));
             }
             (u, l) => missing_molars.extend(
                 [(um, u.is_none()), (lm, l.is_none())]

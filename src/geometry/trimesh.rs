@@ -341,6 +341,16 @@ impl TriMesh {
             .collect()
     }
 
+    /// Mean length of the triangles' edges (each edge counted once per triangle; 0 when empty).
+    pub fn mean_edge_length(&self) -> f32 {
+        let mut sum = 0.0f64;
+        for i in 0..self.triangles.len() {
+            let [a, b, c] = self.triangle(i);
+            sum += f64::from(a.distance(b) + b.distance(c) + c.distance(a));
+        }
+        (sum / (3 * self.triangles.len().max(1)) as f64) as f32
+    }
+
     /// The same surface without the vertices no triangle uses (the rest keep their order).
     pub fn without_unused_vertices(&self) -> Self {
         let mut map = vec![u32::MAX; self.vertices.len()];

@@ -108,21 +108,18 @@ pub fn scan_like_crown(
     for v in &mut mesh.vertices {
         *v += rng.vec(defects.noise_mm);
     }
-    let jitter = mean_edge(&mesh).min(0.2);
+    let jitter = mesh.mean_edge_length().min(0.2);
     cut_at_gum_line(&mut mesh, defects.scallop_mm, jitter, &mut rng);
     let mut mesh = largest_piece(mesh).without_unused_vertices();
     let reference = mesh.clone();
     let mut sites: Vec<(Vec3, f32)> = Vec::new();
+    // Counted up as each defect finds room.
     let mut placed = ScanDefects {
-        holes: 0,
-        spikes: 0,
-        bowties: 0,
-        fins: 0,
-        folds: 0,
-        debris: 0,
-        ..*defects
+        noise_mm: defects.noise_mm,
+        scallop_mm: defects.scallop_mm,
+        ..ScanDefects::CLEAN
     };
-    let edge = mean_edge(&mesh);
+    let edge = mesh.mean_edge_length();
     for _ in 0..defects.holes {
         if let Some(v) = pick_vertex(&mesh, &sites, &mut rng, 3.0 * edge + 0.5, 6.0 * edge) {
             let centre = mesh.vertices[v];
@@ -283,15 +280,6 @@ fn largest_piece(mesh: TriMesh) -> TriMesh {
         .map(|(_, t)| *t)
         .collect();
     TriMesh::new(mesh.vertices, triangles)
-}
-
-fn mean_edge(mesh: &TriMesh) -> f32 {
-    let mut sum = 0.0;
-    for i in 0..mesh.triangles.len() {
-        let [a, b, c] = mesh.triangle(i);
-        sum += a.distance(b) + b.distance(c) + c.distance(a);
-    }
-    sum / (3 * mesh.triangles.len().max(1)) as f32
 }
 
 /// Vertices on the open boundary.

@@ -208,13 +208,7 @@ fn patches_to_cut(crown: &TriMesh, closed: &TriMesh, pairs: &[(usize, usize)]) -
 /// Crown triangles with a vertex within `edges` mean edge lengths (at least `min_mm`) of one of
 /// `points`.
 fn near_points(crown: &TriMesh, points: &[Vec3], edges: f32, min_mm: f32) -> HashSet<usize> {
-    let own = crown.triangles.len();
-    let mut edge = 0.0;
-    for t in 0..own {
-        let [p, q, r] = crown.triangle(t);
-        edge += p.distance(q) + q.distance(r) + r.distance(p);
-    }
-    let radius = (edge / (3 * own.max(1)) as f32 * edges).max(min_mm);
+    let radius = (crown.mean_edge_length() * edges).max(min_mm);
     let key = |p: Vec3| (p / radius).floor().as_ivec3();
     let mut grid: HashMap<IVec3, Vec<Vec3>> = HashMap::new();
     for &s in points {
@@ -232,7 +226,7 @@ fn near_points(crown: &TriMesh, points: &[Vec3], edges: f32, min_mm: f32) -> Has
         })
     };
     let close_vertex: Vec<bool> = crown.vertices.iter().map(|&p| near(p)).collect();
-    (0..own)
+    (0..crown.triangles.len())
         .filter(|&t| crown.triangles[t].iter().any(|&v| close_vertex[v as usize]))
         .collect()
 }
