@@ -72,6 +72,8 @@ pub struct InspectReport {
     pub occlusion: MeasuredOcclusion,
     /// Teeth read from mesh files, with what was repaired in each.
     pub imported: Vec<ImportedMesh>,
+    /// Where the case's mesh and scan files were placed (empty without them).
+    pub orientation: Vec<crate::teeth::OrientationReport>,
 }
 
 /// A tooth read from a mesh file.
@@ -179,6 +181,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
                 repairs: r.clone(),
             })
             .collect(),
+        orientation: d.orientation.clone(),
     }
 }
 

@@ -6,7 +6,8 @@ use anyhow::Result;
 use clap::Args;
 use orthosim::teeth::{
     Case, Dentition,
-    import::{ExportMeshes, export_case_as},
+    import::{ExportMeshes, export_case_as, export_labelled_scans},
+    labelled_scan::ScanFormat,
 };
 
 /// `export-case`'s arguments.
@@ -23,14 +24,55 @@ pub struct ExportCaseArgs {
     /// try the import of scanned crowns; the case then gets generated roots.
     #[arg(long, value_name = "TRIANGLES", value_parser = clap::value_parser!(u32).range(100..=200_000))]
     pub scan_like: Option<u32>,
-    /// Seed of the scan-like defects.
+    /// With `--scan-like`: write each arch as one labelled whole-arch scan (the crowns and a gum
+    /// band) in a random scanner frame and units, as segmentation software exports them: `ply`
+    /// (a per-vertex `label` property), `colours` (per-vertex colours) or `obj` (OBJ with a JSON
+    /// label file). The case names them in `scans` without a transform.
+    #[arg(long, value_enum, requires = "scan_like")]
+    pub labelled: Option<LabelledFormat>,
+    /// Seed of the scan-like defects (and of the scanner frame with `--labelled`).
     #[arg(long, default_value_t = 1, requires = "scan_like")]
     pub seed: u64,
+}
+
+/// How `--labelled` writes the labels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LabelledFormat {
+    /// PLY with an integer `label` per vertex.
+    Ply,
+    /// PLY with a colour per vertex.
+    Colours,
+    /// OBJ with a JSON label file (`{"jaw", "labels"}`).
+    Obj,
 }
 
 /// Exports the case (every output is checked before any is written).
 pub fn run(args: ExportCaseArgs) -> Result<()> {
     let d = Dentition::build(Case::resolve(&args.case)?)?;
+    if let (Some(format), Some(triangles)) = (args.labelled, args.scan_like) {
+        let format = match format {
+            LabelledFormat::Ply => ScanFormat::PlyProperty,
+            LabelledFormat::Colours => ScanFormat::PlyColours,
+            LabelledFormat::Obj => ScanFormat::ObjJson,
+        };
+        let (report, frame) =
+            export_labelled_scans(&d, &args.out, triangles as usize, args.seed, format)?;
+        let (r, t) = orthosim::teeth::import::orient::as_euler_deg(&frame.pose.inverse());
+        println!(
+            "wrote {} ({} scans, {} triangles, {:?}); the scans' true placement: rotation_deg ({:.2}, {:.2}, {:.2}), translation ({:.2}, {:.2}, {:.2}) mm",
+            report.case_file.display(),
+            report.meshes.len(),
+            report.triangles,
+            frame.units,
+            r[0],
+            r[1],
+            r[2],
+            t[0],
+            t[1],
+            t[2]
+        );
+        return Ok(());
+    }
     let meshes = match args.scan_like {
         Some(triangles) => ExportMeshes::ScanLike {
             triangles: triangles as usize,

@@ -75,6 +75,22 @@ fn print_table(report: &InspectReport) {
             if t.extracted { "  extracted" } else { "" }
         );
     }
+    for o in &report.orientation {
+        let [rx, ry, rz] = o.rotation_deg;
+        let [tx, ty, tz] = o.translation;
+        println!(
+            "{} {}: rotation_deg ({rx:.2}, {ry:.2}, {rz:.2}), translation ({tx:.2}, {ty:.2}, {tz:.2}) mm{}",
+            if o.auto {
+                "placed automatically"
+            } else {
+                "placed by its transform"
+            },
+            o.files.join(", "),
+            o.rms_mm
+                .map(|r| format!(" (teeth {r:.2} mm rms from the arrangement's)"))
+                .unwrap_or_default()
+        );
+    }
     if !report.imported.is_empty() {
         println!("teeth read from mesh files (repairs):");
         for m in &report.imported {

@@ -7,9 +7,10 @@ use glam::{Quat, Vec3};
 
 use super::{
     arch::{ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces},
-    case::{Case, CaseError, CaseVector, LoadedCase, WireModel},
+    case::{CaseError, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
-    import::{RepairLimits, Repairs, import_tooth},
+    import::Repairs,
+    patient::{OrientationReport, patient_teeth},
     tooth_shape::{ShapeSet, ToothGeometry},
 };
 use crate::geometry::Pose;
@@ -89,11 +90,16 @@ pub struct Dentition {
     pub groups: Vec<GroupLoad>,
     /// Occlusion measures of the underlying arrangement (before offsets).
     pub arrangement: OcclusionMeasures,
-    /// The arch forms the teeth's cervical centres were placed on: upper, then lower (the upper
-    /// one at the arrangement's height; the bite opening raises the teeth, not the curve in x–z).
+    /// The arch forms of the teeth as they stand: upper, then lower. They are the arrangement's
+    /// (whose curves run through the teeth's cervical centres) unless a tooth was imported or
+    /// offset; then each is the arrangement's form fitted to the cervical centres of its arch's
+    /// present teeth ([`BetaArch::fit`]), which slides teeth and gives imported teeth their
+    /// buccal axis. The bite opening raises the teeth, not the curve in x–z.
     pub arch_forms: [BetaArch; 2],
     /// What was repaired in each imported tooth mesh (teeth with a mesh file only).
     pub imported: std::collections::BTreeMap<Fdi, Repairs>,
+    /// Where the case's mesh and scan files were placed.
+    pub orientation: Vec<OrientationReport>,
 }
 
 impl Dentition {
@@ -103,8 +109,14 @@ impl Dentition {
         let shapes = ShapeSet::shared(case.tooth_resolution());
         let spaces: Spaces = case.spaces.0.iter().map(|(f, s)| (*f, s.0)).collect();
         let arrangement = Arrangement::shared(&shapes, &spaces);
+        let patient = if case.meshes.0.is_empty() && case.scans.is_empty() {
+            None
+        } else {
+            Some(patient_teeth(&loaded, &arrangement)?)
+        };
+        let labelled = patient.as_ref().map_or(&[][..], |p| &p.labelled[..]);
         let mut teeth: Vec<PlacedTooth> = case
-            .present()
+            .present_with(labelled)
             .into_iter()
             .map(|fdi| PlacedTooth {
                 fdi,
@@ -117,32 +129,38 @@ impl Dentition {
                 wire: case.wire_of(fdi),
             })
             .collect();
-        let arch_forms = [arrangement.upper, ArchLayout::default().lower];
+        let mut arch_forms = [arrangement.upper, ArchLayout::default().lower];
         let mut imported_repairs = std::collections::BTreeMap::new();
-        if !case.meshes.0.is_empty() {
-            let curves = arch_forms.map(|f| ArchCurve::new(&f));
-            let files: Vec<_> = case.meshes.0.iter().collect();
-            let limits = RepairLimits::default();
-            let imported = crate::parallel::parallel_map(&files, |(fdi, spec)| {
-                let path = Case::mesh_path(&loaded.origin, &spec.file);
-                let curve = &curves[usize::from(fdi.arch() == Arch::Lower)];
-                import_tooth(&path, spec, **fdi, curve, &limits).map_err(|message| {
-                    CaseError::Mesh {
-                        path: path.display().to_string(),
-                        fdi: **fdi,
-                        case: loaded.origin.clone(),
-                        message,
-                    }
-                })
-            });
-            for ((fdi, _), result) in files.iter().zip(imported) {
-                let tooth = result?;
-                if let Some(t) = teeth.iter_mut().find(|t| t.fdi == **fdi) {
+        let mut orientation = Vec::new();
+        if let Some(patient) = patient {
+            // Each imported tooth's buccal axis comes from the arch as it is: the arrangement's
+            // forms fitted to the cervical centres of the teeth present, imported ones framed on
+            // the arrangement's curves first.
+            let provisional = arch_forms.map(|f| ArchCurve::new(&f));
+            fn curve_of(curves: &[ArchCurve; 2], f: Fdi) -> &ArchCurve {
+                &curves[usize::from(f.arch() == Arch::Lower)]
+            }
+            let framed: Vec<_> = patient
+                .teeth
+                .iter()
+                .map(|(f, _, p)| p.frame(*f, curve_of(&provisional, *f)))
+                .collect();
+            for ((f, _, _), t) in patient.teeth.iter().zip(&framed) {
+                if let Some(placed) = teeth.iter_mut().find(|t| t.fdi == *f) {
+                    placed.pose = t.pose;
+                }
+            }
+            arch_forms = fitted_forms(&teeth, arch_forms);
+            let fitted = arch_forms.map(|f| ArchCurve::new(&f));
+            for (f, _, prepared) in &patient.teeth {
+                let tooth = prepared.frame(*f, curve_of(&fitted, *f));
+                if let Some(t) = teeth.iter_mut().find(|t| t.fdi == *f) {
                     t.geometry = Arc::new(tooth.geometry);
                     t.pose = tooth.pose;
                 }
-                imported_repairs.insert(**fdi, tooth.repairs);
+                imported_repairs.insert(*f, tooth.repairs);
             }
+            orientation = patient.orientation;
         }
         let lift = Vec3::Y * case.bite_opening_mm.0;
         for tooth in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Upper) {
@@ -162,6 +180,9 @@ impl Dentition {
                 let shift = Pose::from_translation(m * t.0.0 + b * t.1.0 + o * t.2.0);
                 tooth.pose = shift.mul(&about_pivot).mul(&tooth.pose);
             }
+        }
+        if !case.offsets.0.is_empty() {
+            arch_forms = fitted_forms(&teeth, arch_forms);
         }
         let mut groups = Vec::new();
         for load in &case.loads {
@@ -192,6 +213,7 @@ impl Dentition {
             arrangement: arrangement.measures,
             arch_forms,
             imported: imported_repairs,
+            orientation,
         })
     }
 
@@ -217,4 +239,18 @@ impl Dentition {
         }
         pairs
     }
+}
+
+/// The arch forms fitted to the cervical centres (local origins) of each arch's present teeth,
+/// starting from `start` (upper, lower).
+fn fitted_forms(teeth: &[PlacedTooth], start: [BetaArch; 2]) -> [BetaArch; 2] {
+    let fit = |arch: Arch, form: BetaArch| {
+        let points: Vec<glam::Vec2> = teeth
+            .iter()
+            .filter(|t| t.fdi.arch() == arch && !t.extracted)
+            .map(|t| glam::Vec2::new(t.pose.translation.x, t.pose.translation.z))
+            .collect();
+        form.fit(&points)
+    };
+    [fit(Arch::Upper, start[0]), fit(Arch::Lower, start[1])]
 }

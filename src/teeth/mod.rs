@@ -14,8 +14,10 @@ mod dentition;
 mod fdi;
 mod frame;
 pub mod import;
+pub mod labelled_scan;
 mod load;
 mod memo;
+mod patient;
 #[cfg(feature = "ecs")]
 mod plugin;
 pub mod scan_like;
@@ -29,6 +31,7 @@ pub use dentition::{Dentition, GroupLoad, PlacedTooth};
 pub use fdi::{Arch, Fdi, InvalidFdi, Side, ToothKind};
 pub use frame::{CentreParameters, ToothFrame};
 pub use load::{Load, LoadError};
+pub use patient::OrientationReport;
 #[cfg(feature = "ecs")]
 pub use plugin::{
     ActiveCase, CaseLoadFailed, CaseLoaded, LoadCase, TeethModelPlugin, TeethModelSystems,

@@ -572,6 +572,53 @@ fn export_case_writes_a_case_that_imports_and_simulates_like_the_original() {
 }
 
 #[test]
+fn a_labelled_scan_export_is_placed_inspected_and_simulated_without_a_transform() {
+    let dir = fresh_dir("labelled");
+    succeed(&[
+        "export-case",
+        "--case",
+        "case1",
+        "--out",
+        dir.to_str().unwrap(),
+        "--scan-like",
+        "1000",
+        "--labelled",
+        "ply",
+        "--seed",
+        "5",
+    ]);
+    let case = dir.join("case1.ron");
+    let text = std::fs::read_to_string(&case).unwrap();
+    assert!(
+        text.contains("scans") && !text.contains("transform: ("),
+        "{text}"
+    );
+    let report = json_of(&["inspect", "--case", case.to_str().unwrap(), "--json"]);
+    let o = report["orientation"].as_array().unwrap();
+    assert_eq!(o.len(), 1, "{o:?}");
+    assert_eq!(o[0]["auto"], true);
+    assert_eq!(o[0]["files"].as_array().unwrap().len(), 2);
+    assert_eq!(o[0]["rotation_deg"].as_array().unwrap().len(), 3);
+    // case1's first premolars are extracted: the scans hold the other 28 teeth.
+    assert_eq!(report["teeth"].as_array().unwrap().len(), 28);
+    assert_eq!(report["imported"].as_array().unwrap().len(), 28);
+    let sim = json_of(&[
+        "simulate",
+        "--case",
+        case.to_str().unwrap(),
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--max-steps",
+        "300",
+        "--json",
+    ]);
+    assert!(!sim["moved"].as_array().unwrap().is_empty(), "{sim}");
+    assert!(sim["max_penetration_mm"].as_f64().unwrap() < 0.05, "{sim}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn outputs_never_replace_the_case_file_being_read() {
     let dir = fresh_dir("inputs");
     let text = "Case(name: \"odd\", teeth: Only([11, 21]))\n";

@@ -6,6 +6,7 @@ mod ecs;
 mod fuzz;
 mod geometry_props;
 mod import;
+mod labelled;
 mod layers;
 mod mesh_files;
 mod movement;

@@ -102,6 +102,93 @@ impl ArchCurve {
     }
 }
 
+impl ArchCurve {
+    /// Distance (mm) from `p` (x, z) to the curve.
+    pub fn distance(&self, p: Vec2) -> f32 {
+        self.at(self.project(p)).0.distance(p)
+    }
+}
+
+/// Fewest points an arch form is fitted to; with fewer, [`BetaArch::fit`] keeps its start.
+pub const MIN_FIT_POINTS: usize = 4;
+
+impl BetaArch {
+    /// The beta arch closest to `points` (x, z; the teeth's cervical centres) in the least-squares
+    /// sense over width, depth and front, starting from `self` (Nelder–Mead on the summed squared
+    /// distances to the curve). With fewer than [`MIN_FIT_POINTS`] points, or when the fit is not
+    /// closer by more than 0.01 mm root mean square, `self` is returned. The form stays symmetric about the midline (x = 0).
+    pub fn fit(&self, points: &[Vec2]) -> BetaArch {
+        if points.len() < MIN_FIT_POINTS || points.iter().any(|p| !p.is_finite()) {
+            return *self;
+        }
+        let form = |v: [f32; 3]| BetaArch {
+            width: v[0],
+            depth: v[1],
+            front_z: v[2],
+        };
+        let cost = |v: [f32; 3]| -> f32 {
+            if !(10.0..=150.0).contains(&v[0]) || !(5.0..=100.0).contains(&v[1]) {
+                return f32::INFINITY;
+            }
+            let curve = ArchCurve::new(&form(v));
+            points.iter().map(|p| curve.distance(*p).powi(2)).sum()
+        };
+        let start = [self.width, self.depth, self.front_z];
+        let mut simplex: Vec<([f32; 3], f32)> = (0..4)
+            .map(|i| {
+                let mut v = start;
+                if i > 0 {
+                    v[i - 1] += 4.0;
+                }
+                (v, cost(v))
+            })
+            .collect();
+        let comb = |a: [f32; 3], b: [f32; 3], t: f32| [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
+        for _ in 0..200 {
+            simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+            if simplex[3].1 - simplex[0].1 <= 1e-5 * (1.0 + simplex[0].1) {
+                break;
+            }
+            let centroid =
+                [0, 1, 2].map(|k| simplex[..3].iter().map(|s| s.0[k]).sum::<f32>() / 3.0);
+            let worst = simplex[3];
+            let reflected = comb(centroid, worst.0, -1.0);
+            let fr = cost(reflected);
+            if fr < simplex[0].1 {
+                let expanded = comb(centroid, worst.0, -2.0);
+                let fe = cost(expanded);
+                simplex[3] = if fe < fr {
+                    (expanded, fe)
+                } else {
+                    (reflected, fr)
+                };
+            } else if fr < simplex[2].1 {
+                simplex[3] = (reflected, fr);
+            } else {
+                let contracted = comb(centroid, worst.0, 0.5);
+                let fc = cost(contracted);
+                if fc < worst.1 {
+                    simplex[3] = (contracted, fc);
+                } else {
+                    let best = simplex[0].0;
+                    for s in simplex.iter_mut().skip(1) {
+                        s.0 = comb(best, s.0, 0.5);
+                        s.1 = cost(s.0);
+                    }
+                }
+            }
+        }
+        simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
+        // Keep the start unless the fit is better by more than 0.01 mm root mean square.
+        let rms = |c: f32| (c / points.len() as f32).sqrt();
+        if rms(simplex[0].1) < rms(cost(start)) - 0.01 {
+            form(simplex[0].0)
+        } else {
+            *self
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,5 +230,35 @@ mod tests {
             let back = curve.project(p);
             assert!((back - s).abs() < 0.02, "{s} -> {back}");
         }
+    }
+
+    #[test]
+    fn the_fit_recovers_a_form_from_its_points() {
+        let truth = BetaArch {
+            width: 54.0,
+            depth: 31.0,
+            front_z: 16.0,
+        };
+        let curve = ArchCurve::new(&truth);
+        let points: Vec<Vec2> = [
+            -40.0f32, -30.0, -18.0, -9.0, -3.0, 3.0, 11.0, 22.0, 33.0, 41.0,
+        ]
+        .iter()
+        .map(|s| curve.at(*s).0)
+        .collect();
+        let start = BetaArch {
+            width: 50.0,
+            depth: 36.0,
+            front_z: 18.0,
+        };
+        let fitted = start.fit(&points);
+        let fc = ArchCurve::new(&fitted);
+        let worst = points
+            .iter()
+            .map(|p| fc.distance(*p))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 0.05, "{fitted:?}: {worst} mm");
+        // Too few points: the start is kept.
+        assert_eq!(start.fit(&points[..3]), start);
     }
 }

@@ -67,6 +67,16 @@ pub enum CaseError {
         /// What is wrong.
         message: String,
     },
+    /// A labelled scan could not be read or split, or its teeth not placed.
+    #[error("{path}: {message} (named in {case})")]
+    Scan {
+        /// The scan file(s).
+        path: String,
+        /// The case file that names it.
+        case: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A tooth's mesh file could not be imported.
     #[error("{path}: {message} (tooth {fdi}, named in {case})")]
     Mesh {
@@ -98,9 +108,10 @@ pub struct Case {
     /// Vertices per procedural tooth (default 125).
     #[serde(default)]
     pub resolution: Option<u32>,
-    /// Teeth present in the mouth.
-    #[serde(default)]
-    pub teeth: PresentTeeth,
+    /// Teeth present in the mouth. Unwritten: all 32, or with `scans`, the teeth the scans label
+    /// and `meshes` names.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub teeth: Option<PresentTeeth>,
     /// Extracted teeth (present in the data, hidden, skipped by the simulation).
     #[serde(default)]
     pub extracted: ToothList,
@@ -130,6 +141,10 @@ pub struct Case {
     /// (0.0, 2.0, 0.0)))}`; see [`crate::teeth::import`]. Other teeth are procedural.
     #[serde(default)]
     pub meshes: ToothMap<crate::teeth::import::ToothMeshFile>,
+    /// Labelled whole-arch scans, e.g. `[(file: "lower.ply", labels: Property("label"))]`: each
+    /// labelled tooth becomes a scanned crown; see [`crate::teeth::import::ScanFile`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub scans: Vec<crate::teeth::import::ScanFile>,
 }
 
 /// A case with where it came from.
@@ -216,10 +231,14 @@ impl Case {
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
             .from_str(source)
             .map_err(|e| invalid(e.span.start.line, e.span.start.col, e.code.to_string()))?;
-        case.check().map_err(|(field, token, message)| {
-            let (line, column) = locate(source, field, token.as_deref());
-            invalid(line, column, message)
-        })?;
+        // With presence from the scans, the checks that need the teeth present wait for the
+        // labels (`LoadedCase::check_present`).
+        let present = (!case.presence_from_scans()).then(|| case.present());
+        case.check(present.as_deref())
+            .map_err(|(field, token, message)| {
+                let (line, column) = locate(source, field, token.as_deref());
+                invalid(line, column, message)
+            })?;
         Ok(LoadedCase {
             case,
             origin: origin.to_owned(),
@@ -227,15 +246,30 @@ impl Case {
         })
     }
 
-    /// The teeth present in the mouth (extracted ones included).
+    /// The teeth present in the mouth (extracted ones included). With `scans` and no `teeth`, the
+    /// teeth present are only known once the scans are read: see [`Case::present_with`].
     pub fn present(&self) -> Vec<Fdi> {
+        self.present_with(&[])
+    }
+
+    /// The teeth present, given the teeth the scans label (used when the case has `scans` and
+    /// does not write `teeth`: then the teeth present are those labelled or named in `meshes`).
+    pub fn present_with(&self, labelled: &[Fdi]) -> Vec<Fdi> {
         Fdi::all()
             .filter(|f| match &self.teeth {
-                PresentTeeth::All => true,
-                PresentTeeth::Only(l) => l.0.contains(f),
-                PresentTeeth::AllBut(l) => !l.0.contains(f),
+                None if self.presence_from_scans() => {
+                    labelled.contains(f) || self.meshes.0.contains_key(f)
+                }
+                None | Some(PresentTeeth::All) => true,
+                Some(PresentTeeth::Only(l)) => l.0.contains(f),
+                Some(PresentTeeth::AllBut(l)) => !l.0.contains(f),
             })
             .collect()
+    }
+
+    /// True when the teeth present come from the scans' labels (scans and no `teeth`).
+    pub fn presence_from_scans(&self) -> bool {
+        self.teeth.is_none() && !self.scans.is_empty()
     }
 
     /// True when the tooth is present and extracted.
@@ -276,8 +310,9 @@ impl Case {
             })
     }
 
-    /// Cross-field checks: (field, offending token, message).
-    fn check(&self) -> Result<(), (&'static str, Option<String>, String)> {
+    /// Cross-field checks: (field, offending token, message); those that need the teeth present
+    /// only when `present` is known.
+    fn check(&self, present: Option<&[Fdi]>) -> Result<(), (&'static str, Option<String>, String)> {
         let length = self.name.chars().count();
         if !(1..=MAX_NAME_CHARS).contains(&length) {
             return Err((
@@ -296,7 +331,6 @@ impl Case {
                 ),
             ));
         }
-        let present = self.present();
         if let Some(r) = self.resolution
             && !(20..=200_000).contains(&r)
         {
@@ -316,6 +350,10 @@ impl Case {
                 ),
             ));
         }
+        self.check_files()?;
+        let Some(present) = present else {
+            return Ok(());
+        };
         for f in &self.extracted.0 {
             if !present.contains(f) {
                 return Err((
@@ -375,18 +413,6 @@ impl Case {
         for f in self.meshes.0.keys() {
             absent("meshes", f)?;
         }
-        for (f, m) in &self.meshes.0 {
-            if m.file.trim().is_empty() {
-                return Err((
-                    "meshes",
-                    Some(f.to_string()),
-                    format!("the mesh file of tooth {f} is empty"),
-                ));
-            }
-            if let Err(e) = crate::teeth::import::MeshFormat::of(Path::new(&m.file)) {
-                return Err(("meshes", Some(m.file.clone()), format!("{}: {e}", m.file)));
-            }
-        }
         for load in &self.loads {
             if load.teeth.0.is_empty() {
                 return Err(("loads", None, "a load must name at least one tooth".into()));
@@ -426,6 +452,79 @@ impl Case {
             absent("wire", f)?;
         }
         Ok(())
+    }
+}
+
+impl Case {
+    /// Checks of the mesh and scan file names: (field, offending token, message).
+    fn check_files(&self) -> Result<(), (&'static str, Option<String>, String)> {
+        use crate::teeth::import::{Labels, MeshFormat};
+        for (f, m) in &self.meshes.0 {
+            if m.file.trim().is_empty() {
+                return Err((
+                    "meshes",
+                    Some(f.to_string()),
+                    format!("the mesh file of tooth {f} is empty"),
+                ));
+            }
+            if let Err(e) = MeshFormat::of(Path::new(&m.file)) {
+                return Err(("meshes", Some(m.file.clone()), format!("{}: {e}", m.file)));
+            }
+        }
+        for scan in &self.scans {
+            if scan.file.trim().is_empty() {
+                return Err(("scans", None, "a scan's file name is empty".into()));
+            }
+            if let Err(e) = MeshFormat::of(Path::new(&scan.file)) {
+                return Err((
+                    "scans",
+                    Some(scan.file.clone()),
+                    format!("{}: {e}", scan.file),
+                ));
+            }
+            match &scan.labels {
+                Labels::Json(file) if file.trim().is_empty() => {
+                    return Err(("scans", None, "a scan's label file name is empty".into()));
+                }
+                Labels::Property(name) if name.trim().is_empty() => {
+                    return Err((
+                        "scans",
+                        None,
+                        "a scan's label property name is empty".into(),
+                    ));
+                }
+                Labels::Colours(map) if map.is_empty() => {
+                    return Err((
+                        "scans",
+                        Some(scan.file.clone()),
+                        format!("the scan {} lists no tooth colours", scan.file),
+                    ));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+impl LoadedCase {
+    /// The checks that need the teeth present, once the scans' labels are known (cases with
+    /// scans and no `teeth`).
+    ///
+    /// # Errors
+    /// [`CaseError::Invalid`] with the position of the first problem.
+    pub fn check_present(&self, present: &[Fdi]) -> Result<(), CaseError> {
+        self.case
+            .check(Some(present))
+            .map_err(|(field, token, message)| {
+                let (line, column) = locate(&self.source, field, token.as_deref());
+                CaseError::Invalid {
+                    path: self.origin.clone(),
+                    line,
+                    column,
+                    message,
+                }
+            })
     }
 }
 

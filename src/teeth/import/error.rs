@@ -164,6 +164,9 @@ pub enum ImportError {
         /// Its signed volume.
         volume: f64,
     },
+    /// A labelled scan's labels are missing, malformed or do not fit its mesh.
+    #[error("{0}")]
+    Labels(String),
     /// The repaired mesh fails another check of a closed solid.
     #[error("the repaired mesh is not a closed solid: {0}")]
     NotSolid(MeshError),

@@ -6,12 +6,14 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::{MeshTransform, ToothMeshFile, Units, write_stl};
+use super::{Labels, Placement, ScanFile, ToothMeshFile, Units, write_stl};
 use crate::{
     io::{OutputError, OutputSet},
     teeth::{
         Dentition,
         case::{Case, ToothMap},
+        fdi::Arch,
+        labelled_scan::{ScanFormat, ScannerFrame, labelled_arch, tooth_colour, write_scan},
         scan_like::{ScanDefects, scan_like_crown},
     },
 };
@@ -115,7 +117,7 @@ pub fn export_case_as(
             ToothMeshFile {
                 file: format!("{}.stl", t.fdi.number()),
                 units: Units::Millimetres,
-                transform: MeshTransform::default(),
+                transform: Placement::Identity,
             },
         );
     }
@@ -147,6 +149,118 @@ pub fn export_case_as(
         meshes,
         triangles,
     })
+}
+
+/// Writes the visible teeth of `d` as two labelled whole-arch scans (`upper` and `lower`, each
+/// the scan-like crowns of its teeth and a gum band, [`crate::teeth::labelled_scan`]) in one
+/// random scanner frame drawn from `seed` (rotation, translation, units), and the case as
+/// `NAME.ron` naming them in `scans` with their units and no transform, so orthosim places them
+/// itself. All or nothing, as [`export_case`].
+///
+/// # Errors
+/// The first output that cannot or must not be written ([`OutputError`]).
+pub fn export_labelled_scans(
+    d: &Dentition,
+    dir: &Path,
+    triangles: usize,
+    seed: u64,
+    format: ScanFormat,
+) -> Result<(ExportReport, ScannerFrame), OutputError> {
+    let source = Path::new(&d.case.origin);
+    let mut case: Case = d.case.case.clone();
+    let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
+    let mut inputs = vec![source.to_owned()];
+    inputs.extend(
+        case.meshes
+            .0
+            .values()
+            .map(|m| Case::mesh_path(&d.case.origin, &m.file)),
+    );
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    let extension = match format {
+        ScanFormat::ObjJson => "obj",
+        _ => "ply",
+    };
+    let arches: Vec<Arch> = [Arch::Upper, Arch::Lower]
+        .into_iter()
+        .filter(|a| d.visible().any(|t| t.fdi.arch() == *a))
+        .collect();
+    let name = |a: Arch| match a {
+        Arch::Upper => "upper",
+        Arch::Lower => "lower",
+    };
+    let mut meshes = Vec::new();
+    let mut outputs = Vec::new();
+    for a in &arches {
+        let mesh = dir.join(format!("{}.{extension}", name(*a)));
+        meshes.push(mesh.clone());
+        outputs.push(mesh);
+        if format == ScanFormat::ObjJson {
+            outputs.push(dir.join(format!("{}.json", name(*a))));
+        }
+    }
+    outputs.push(case_file.clone());
+    let mut set = OutputSet::new(dir, outputs, &inputs)?;
+    let frame = ScannerFrame::random(seed);
+    let mut written = 0;
+    let mut scans = Vec::new();
+    for a in &arches {
+        let arch = labelled_arch(d, *a, triangles, seed);
+        let placed = frame.apply(&arch.mesh);
+        written += placed.triangles.len();
+        let (bytes, json) = write_scan(&arch, &placed, format);
+        let file = format!("{}.{extension}", name(*a));
+        set.write(&dir.join(&file), bytes)?;
+        let labels = match (format, json) {
+            (ScanFormat::ObjJson, Some(json)) => {
+                let label_file = format!("{}.json", name(*a));
+                set.write(&dir.join(&label_file), json)?;
+                Labels::Json(label_file)
+            }
+            (ScanFormat::PlyColours, _) => Labels::Colours(
+                d.visible()
+                    .filter(|t| t.fdi.arch() == *a)
+                    .map(|t| (tooth_colour(t.fdi), t.fdi))
+                    .collect(),
+            ),
+            _ => Labels::Property("label".into()),
+        };
+        scans.push(ScanFile {
+            file,
+            labels,
+            units: frame.units,
+            transform: Placement::Auto,
+        });
+    }
+    // The scans hold the visible teeth where the case placed them.
+    case.meshes = ToothMap::default();
+    case.scans = scans;
+    case.teeth = None;
+    case.extracted = Default::default();
+    case.offsets = ToothMap::default();
+    case.bite_opening_mm = Default::default();
+    let text =
+        ron::ser::to_string_pretty(&case, ron::ser::PrettyConfig::default().struct_names(true))
+            .map_err(|e| OutputError::Write {
+                path: case_file.clone(),
+                source: std::io::Error::other(e),
+            })?;
+    let header = format!(
+        "// Exported by `orthosim export-case --labelled` from {}: each arch one labelled scan of\n\
+         // scan-like crowns (about {triangles} triangles each, defects of seed {seed}) and a gum,\n\
+         // in a random scanner frame: no transform is written, orthosim places the scans itself.\n",
+        d.case.origin
+    );
+    set.write(&case_file, format!("{header}{text}\n"))?;
+    set.commit()?;
+    Ok((
+        ExportReport {
+            case_file,
+            meshes,
+            triangles: written,
+        },
+        frame,
+    ))
 }
 
 fn file_stem(name: &str) -> String {

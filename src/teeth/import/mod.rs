@@ -1,10 +1,13 @@
-//! Real patients: tooth meshes from segmentation software (STL, OBJ, PLY), one file per tooth.
+//! Real patients: tooth meshes from segmentation software (STL, OBJ, PLY), one file per tooth or
+//! one labelled mesh per arch ([`Labels`]).
 //!
-//! A case names a file per tooth in `meshes` (paths relative to the case file), each with its
-//! units (millimetres by default; metres and inches are converted) and an optional transform
-//! (rotation in degrees about x, then y, then z, then translation in mm) that brings the scan into
-//! orthosim's frame: millimetres, y towards the upper arch, z forwards (labial at the incisors), x
-//! towards the patient's left, the origin between the arches at the midline.
+//! A case names a file per tooth in `meshes` and labelled whole-arch scans in `scans` (paths
+//! relative to the case file), each with its units (millimetres by default; metres and inches are
+//! converted) and a [`Placement`]: `Auto` (the default) lets orthosim find the frame from the
+//! labelled teeth ([`orient`]), `Identity` keeps the file's coordinates, and a transform (rotation
+//! in degrees about x, then y, then z, then translation in mm) brings the file into orthosim's
+//! frame: millimetres, y towards the upper arch, z forwards (labial at the incisors), x towards the
+//! patient's left, the origin between the arches at the midline.
 //!
 //! Each mesh is checked and repaired as real scans need ([`repair`]: welding, degenerate and
 //! duplicated triangles, fins on non-manifold edges, bow-tie vertices, spikes, winding, loose
@@ -18,8 +21,8 @@
 //!
 //! - long axis (local y): the principal axis of inertia closest to the arch's occlusal direction
 //!   (+y for the lower arch, −y for the upper), pointing occlusally;
-//! - buccal axis (local z): the outward normal of the case's arch curve at the tooth, made
-//!   perpendicular to the long axis; local x = y × z;
+//! - buccal axis (local z): the outward normal of the arch curve at the tooth (the arrangement's
+//!   form fitted to the teeth present), made perpendicular to the long axis; local x = y × z;
 //! - origin: the cervical centre: the centroid of the margin for a scanned crown, else the point of
 //!   the long axis one crown length (anatomy table) below the crown's highest point.
 //!
@@ -30,7 +33,9 @@ mod close;
 mod error;
 mod export;
 mod fill;
+mod labels;
 mod mend;
+pub mod orient;
 mod read;
 pub mod repair;
 pub mod root;
@@ -50,7 +55,8 @@ use super::{
 use crate::geometry::{MassProperties, Pose, TriMesh};
 
 pub use error::{ImportError, Near, PlyProblem};
-pub use export::{ExportMeshes, ExportReport, export_case, export_case_as};
+pub use export::{ExportMeshes, ExportReport, export_case, export_case_as, export_labelled_scans};
+pub use labels::{LabelledMesh, Labels, check_raw, check_scan, read_labelled, split};
 pub use read::{MeshFormat, read_mesh, write_stl};
 pub use repair::{RepairLimits, Repairs};
 
@@ -102,6 +108,90 @@ impl MeshTransform {
     }
 }
 
+/// Where a mesh file's coordinates are: found by orthosim from the labelled teeth (`Auto`, the
+/// default), already orthosim's frame (`Identity`), or brought there by a given transform
+/// (`(translation: (x, y, z), rotation_deg: (x, y, z))`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Placement {
+    /// Placed by orthosim: see [`orient`].
+    #[default]
+    Auto,
+    /// The file is in orthosim's frame (after units).
+    Identity,
+    /// This transform brings the file (after units) into orthosim's frame.
+    Rigid(MeshTransform),
+}
+
+impl Placement {
+    /// The transform, `None` for `Auto`.
+    pub fn pose(&self) -> Option<Pose> {
+        match self {
+            Placement::Auto => None,
+            Placement::Identity => Some(Pose::IDENTITY),
+            Placement::Rigid(t) => Some(t.pose()),
+        }
+    }
+}
+
+impl Serialize for Placement {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Placement::Auto => s.serialize_unit_variant("Placement", 0, "Auto"),
+            Placement::Identity => s.serialize_unit_variant("Placement", 1, "Identity"),
+            Placement::Rigid(t) => t.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Placement {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        #[derive(Deserialize)]
+        #[serde(
+            untagged,
+            expecting = "a transform: Auto, Identity or (translation: (x, y, z), rotation_deg: (x, y, z))"
+        )]
+        enum Raw {
+            Word(String),
+            Fields(std::collections::BTreeMap<String, (f64, f64, f64)>),
+        }
+        match Raw::deserialize(d)? {
+            Raw::Word(w) if w == "Auto" => Ok(Placement::Auto),
+            Raw::Word(w) if w == "Identity" => Ok(Placement::Identity),
+            Raw::Word(w) => Err(D::Error::custom(format!(
+                "unknown transform `{w}`: Auto, Identity or (translation: (x, y, z), rotation_deg: (x, y, z))"
+            ))),
+            Raw::Fields(fields) => {
+                let mut t = MeshTransform::default();
+                for (name, (a, b, c)) in fields {
+                    let mut triple = (Finite(0.0), Finite(0.0), Finite(0.0));
+                    for (slot, v) in [&mut triple.0, &mut triple.1, &mut triple.2]
+                        .into_iter()
+                        .zip([a, b, c])
+                    {
+                        if !v.is_finite() || v.abs() > f32::MAX as f64 {
+                            return Err(D::Error::custom(format!(
+                                "number must be finite, got {v}"
+                            )));
+                        }
+                        *slot = Finite(v as f32);
+                    }
+                    match name.as_str() {
+                        "translation" => t.translation = triple,
+                        "rotation_deg" => t.rotation_deg = triple,
+                        other => {
+                            return Err(D::Error::custom(format!(
+                                "unknown field `{other}` of a transform, expected `translation` or `rotation_deg`"
+                            )));
+                        }
+                    }
+                }
+                Ok(Placement::Rigid(t))
+            }
+        }
+    }
+}
+
 /// A tooth's mesh file in a case.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -111,9 +201,25 @@ pub struct ToothMeshFile {
     /// Units of the file's coordinates.
     #[serde(default)]
     pub units: Units,
-    /// Transform into orthosim's frame.
+    /// Where the file's frame is.
     #[serde(default)]
-    pub transform: MeshTransform,
+    pub transform: Placement,
+}
+
+/// A labelled whole-arch scan in a case: each labelled tooth becomes a scanned crown.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScanFile {
+    /// Path of the mesh, relative to the case file.
+    pub file: String,
+    /// How its teeth are labelled.
+    pub labels: Labels,
+    /// Units of the file's coordinates.
+    #[serde(default)]
+    pub units: Units,
+    /// Where the file's frame is.
+    #[serde(default)]
+    pub transform: Placement,
 }
 
 /// The least extent of a tooth mesh (mm): smaller ones are refused (wrong units, or not a tooth).
@@ -139,8 +245,19 @@ pub struct ImportedTooth {
     pub repairs: Repairs,
 }
 
-/// Reads, repairs and frames the mesh of tooth `fdi` from `path`; `curve` is the arch curve of
-/// the tooth's arch (for its buccal direction).
+/// Reads a tooth's or scan's mesh file, in millimetres, in the file's own frame.
+///
+/// # Errors
+/// What is wrong and where, without the path ([`ImportError`]).
+pub fn read_in_mm(path: &Path, units: Units) -> Result<TriMesh, ImportError> {
+    let raw = read_mesh(path)?;
+    let scale = units.mm();
+    Ok(raw.map_vertices(|v| v * scale))
+}
+
+/// Reads, repairs and frames the mesh of tooth `fdi` from `path`, placed by its own transform
+/// (`Auto` is taken as `Identity` here: automatic placement needs the case's other teeth, see
+/// [`orient`]); `curve` is the arch curve of the tooth's arch (for its buccal direction).
 ///
 /// # Errors
 /// What is wrong and where, without the path ([`ImportError`]).
@@ -151,10 +268,8 @@ pub fn import_tooth(
     curve: &ArchCurve,
     limits: &RepairLimits,
 ) -> Result<ImportedTooth, ImportError> {
-    let raw = read_mesh(path)?;
-    let transform = spec.transform.pose();
-    let scale = spec.units.mm();
-    let world = raw.map_vertices(|v| transform.transform_point(v * scale));
+    let transform = spec.transform.pose().unwrap_or(Pose::IDENTITY);
+    let world = read_in_mm(path, spec.units)?.map_vertices(|v| transform.transform_point(v));
     import_mesh(&world, fdi, curve, limits)
 }
 
@@ -168,6 +283,26 @@ pub fn import_mesh(
     curve: &ArchCurve,
     limits: &RepairLimits,
 ) -> Result<ImportedTooth, ImportError> {
+    Ok(prepare(world, fdi, limits)?.frame(fdi, curve))
+}
+
+/// A tooth mesh repaired and closed where the scan put it, not yet framed.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The closed mesh in orthosim's frame.
+    pub mesh: TriMesh,
+    /// The centroid of the cervical margin, for a scanned crown.
+    pub cervical: Option<Vec3>,
+    /// What was repaired.
+    pub repairs: Repairs,
+}
+
+/// Checks and repairs a tooth mesh in orthosim's frame (mm), and closes a scanned crown with a
+/// generated root.
+///
+/// # Errors
+/// What is wrong and where ([`ImportError`]).
+pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepared, ImportError> {
     let an = anatomy(fdi.arch(), fdi.kind());
     // Absurd sizes (far beyond any unit mix-up with debris) are refused before any repair.
     if world.vertices.iter().all(|v| v.is_finite()) && !world.vertices.is_empty() {
@@ -193,15 +328,27 @@ pub fn import_mesh(
     }
     let close::Closed { mesh, cervical } =
         close::close(crown, fdi, an.root_length, limits, &mut repairs)?;
-    let pose = tooth_pose(&mesh, fdi, curve, cervical, an.crown_length);
-    let inverse = pose.inverse();
-    let local = mesh.map_vertices(|v| inverse.transform_point(v));
-    let geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
-    Ok(ImportedTooth {
-        geometry,
-        pose,
+    Ok(Prepared {
+        mesh,
+        cervical,
         repairs,
     })
+}
+
+impl Prepared {
+    /// The tooth framed on the arch `curve` (see the module doc).
+    pub fn frame(&self, fdi: Fdi, curve: &ArchCurve) -> ImportedTooth {
+        let an = anatomy(fdi.arch(), fdi.kind());
+        let pose = tooth_pose(&self.mesh, fdi, curve, self.cervical, an.crown_length);
+        let inverse = pose.inverse();
+        let local = self.mesh.map_vertices(|v| inverse.transform_point(v));
+        let geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
+        ImportedTooth {
+            geometry,
+            pose,
+            repairs: self.repairs.clone(),
+        }
+    }
 }
 
 /// The occlusal direction of an arch in orthosim's frame.

@@ -76,7 +76,7 @@ pub fn read_mesh(path: &Path) -> Result<TriMesh, ImportError> {
 }
 
 /// The parser's message as the detail of a malformed file (on one line).
-fn malformed(format: MeshFormat, e: impl std::fmt::Display) -> ImportError {
+pub(super) fn malformed(format: MeshFormat, e: impl std::fmt::Display) -> ImportError {
     ImportError::Malformed {
         format,
         detail: one_line(&e.to_string()),
@@ -178,10 +178,18 @@ fn obj_bad_line(path: &Path) -> Option<usize> {
 }
 
 fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, ImportError> {
-    use ply_rs_bw::{parser::Parser, ply::DefaultElement, ply::Property};
+    use ply_rs_bw::{parser::Parser, ply::DefaultElement};
     let ply = Parser::<DefaultElement>::new()
         .read_ply(reader)
         .map_err(|e| malformed(MeshFormat::Ply, e))?;
+    ply_mesh(&ply).map(|(mesh, _)| mesh)
+}
+
+/// The mesh of a parsed PLY file, and the face each triangle comes from (polygons become fans).
+pub(super) fn ply_mesh(
+    ply: &ply_rs_bw::ply::Ply<ply_rs_bw::ply::DefaultElement>,
+) -> Result<(TriMesh, Vec<usize>), ImportError> {
+    use ply_rs_bw::ply::Property;
     let scalar = |p: &Property| -> Option<f64> {
         Some(match *p {
             Property::Char(v) => v as f64,
@@ -225,6 +233,7 @@ fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, ImportError> {
         .payload
         .get("face")
         .ok_or(ImportError::PlyContent(PlyProblem::NoElement("face")))?;
+    let mut face_of_triangle = Vec::new();
     for (i, f) in faces.iter().enumerate() {
         let indices = f
             .get("vertex_indices")
@@ -247,9 +256,10 @@ fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, ImportError> {
                 index(indices[k])?,
                 index(indices[k + 1])?,
             ]);
+            face_of_triangle.push(i);
         }
     }
-    Ok(mesh)
+    Ok((mesh, face_of_triangle))
 }
 
 /// Writes a mesh as binary STL (facet normals from the triangles).

@@ -1,0 +1,256 @@
+//! A case's patient teeth: every tooth of `meshes` and every labelled tooth of `scans`, read in
+//! millimetres, placed in orthosim's frame (by its file's transform, or automatically with the
+//! other files of the case's shared frame), then repaired and closed ([`crate::teeth::import`]).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::{
+    arch::Arrangement,
+    case::{Case, CaseError, LoadedCase},
+    fdi::Fdi,
+    import::{
+        ImportError, Placement, Prepared, RepairLimits, check_raw, check_scan,
+        orient::{Arranged, REFERENCE_RESOLUTION, as_euler_deg, orient},
+        prepare, read_in_mm, read_labelled, split,
+    },
+    tooth_shape::ShapeSet,
+};
+use crate::geometry::{Pose, TriMesh};
+
+/// Where the files of a case were placed: one entry for all the files placed automatically (they
+/// share a frame), one per file with its own transform.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OrientationReport {
+    /// The files, as the case names them.
+    pub files: Vec<String>,
+    /// Rotation (degrees about x, then y, then z) into orthosim's frame, as a case's `transform`
+    /// writes it.
+    pub rotation_deg: [f32; 3],
+    /// Translation (mm) after the rotation.
+    pub translation: [f32; 3],
+    /// True when orthosim found it from the labelled teeth.
+    pub auto: bool,
+    /// For an automatic placement: root-mean-square distance (mm) of the teeth's occlusal caps
+    /// from the arrangement's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rms_mm: Option<f32>,
+}
+
+/// One imported tooth's raw mesh, before placement.
+struct Source {
+    fdi: Fdi,
+    /// The file as the case names it, and its resolved path.
+    file: String,
+    path: String,
+    /// Millimetres, the file's frame.
+    mesh: TriMesh,
+    placement: Placement,
+    /// From a labelled scan.
+    scanned: bool,
+}
+
+/// The patient's teeth of a case, placed and prepared.
+pub(super) struct PatientTeeth {
+    /// Prepared teeth with the file they came from.
+    pub teeth: Vec<(Fdi, String, Prepared)>,
+    /// The teeth the scans label.
+    pub labelled: Vec<Fdi>,
+    /// Where the files went.
+    pub orientation: Vec<OrientationReport>,
+}
+
+/// Reads, places and prepares the case's `meshes` and `scans`.
+pub(super) fn patient_teeth(
+    loaded: &LoadedCase,
+    arrangement: &Arrangement,
+) -> Result<PatientTeeth, CaseError> {
+    let case = &loaded.case;
+    let sources = read_sources(loaded)?;
+    let labelled: Vec<Fdi> = sources
+        .iter()
+        .filter(|s| s.scanned)
+        .map(|s| s.fdi)
+        .collect();
+    if case.presence_from_scans() {
+        loaded.check_present(&case.present_with(&labelled))?;
+    }
+    let present = case.present_with(&labelled);
+    if let Some(s) = sources.iter().find(|s| !present.contains(&s.fdi)) {
+        return Err(scan_error(
+            loaded,
+            &s.path,
+            format!(
+                "the scan labels tooth {}, which the case's `teeth` leaves out",
+                s.fdi
+            ),
+        ));
+    }
+    // Placement.
+    let mut orientation = Vec::new();
+    let mut poses: Vec<Pose> = vec![Pose::IDENTITY; sources.len()];
+    let auto: Vec<usize> = (0..sources.len())
+        .filter(|&i| sources[i].placement == Placement::Auto)
+        .collect();
+    if !auto.is_empty() {
+        let teeth: Vec<(Fdi, &TriMesh)> = auto
+            .iter()
+            .map(|&i| (sources[i].fdi, &sources[i].mesh))
+            .collect();
+        let mut files: Vec<String> = Vec::new();
+        for &i in &auto {
+            if !files.contains(&sources[i].file) {
+                files.push(sources[i].file.clone());
+            }
+        }
+        let reference = ShapeSet::shared(REFERENCE_RESOLUTION);
+        let geometries: BTreeMap<Fdi, _> = teeth
+            .iter()
+            .map(|(f, _)| (*f, reference.get(f.arch(), f.kind())))
+            .collect();
+        let found = orient(&teeth, |fdi| Arranged {
+            mesh: &geometries[&fdi].mesh,
+            pose: arrangement.pose(fdi),
+        })
+        .map_err(|e| scan_error(loaded, &files.join(", "), e.to_string()))?;
+        for &i in &auto {
+            poses[i] = found.pose;
+        }
+        let (rotation_deg, translation) = as_euler_deg(&found.pose);
+        orientation.push(OrientationReport {
+            files,
+            rotation_deg,
+            translation,
+            auto: true,
+            rms_mm: Some(found.rms_mm),
+        });
+    }
+    for (i, s) in sources.iter().enumerate() {
+        let Some(pose) = s.placement.pose() else {
+            continue;
+        };
+        poses[i] = pose;
+        if orientation
+            .iter()
+            .any(|r| !r.auto && r.files.first() == Some(&s.file))
+        {
+            continue;
+        }
+        let (rotation_deg, translation) = as_euler_deg(&pose);
+        orientation.push(OrientationReport {
+            files: vec![s.file.clone()],
+            rotation_deg,
+            translation,
+            auto: false,
+            rms_mm: None,
+        });
+    }
+    // Repair and close, on all cores.
+    let jobs: Vec<(usize, Pose)> = poses.into_iter().enumerate().collect();
+    let limits = RepairLimits::default();
+    let prepared = crate::parallel::parallel_map(&jobs, |(i, pose)| {
+        let s = &sources[*i];
+        let world = s.mesh.map_vertices(|v| pose.transform_point(v));
+        prepare(&world, s.fdi, &limits).map_err(|message| CaseError::Mesh {
+            path: s.path.clone(),
+            fdi: s.fdi,
+            case: loaded.origin.clone(),
+            message,
+        })
+    });
+    let mut teeth = Vec::with_capacity(sources.len());
+    for (s, p) in sources.iter().zip(prepared) {
+        teeth.push((s.fdi, s.path.clone(), p?));
+    }
+    Ok(PatientTeeth {
+        teeth,
+        labelled,
+        orientation,
+    })
+}
+
+fn scan_error(loaded: &LoadedCase, path: &str, message: String) -> CaseError {
+    CaseError::Scan {
+        path: path.to_owned(),
+        case: loaded.origin.clone(),
+        message,
+    }
+}
+
+/// Every imported tooth's raw mesh, in millimetres in its file's frame: one per `meshes` entry,
+/// one per labelled tooth of each scan. A tooth given twice is refused.
+fn read_sources(loaded: &LoadedCase) -> Result<Vec<Source>, CaseError> {
+    let case = &loaded.case;
+    let mesh_error = |path: &str, fdi: Fdi, message: ImportError| CaseError::Mesh {
+        path: path.to_owned(),
+        fdi,
+        case: loaded.origin.clone(),
+        message,
+    };
+    let files: Vec<_> = case.meshes.0.iter().collect();
+    let read = crate::parallel::parallel_map(&files, |(fdi, spec)| {
+        let path = Case::mesh_path(&loaded.origin, &spec.file);
+        let shown = path.display().to_string();
+        read_in_mm(&path, spec.units)
+            .and_then(|mesh| check_raw(&mesh).map(|()| mesh))
+            .map(|mesh| Source {
+                fdi: **fdi,
+                file: spec.file.clone(),
+                path: shown.clone(),
+                mesh,
+                placement: spec.transform,
+                scanned: false,
+            })
+            .map_err(|e| mesh_error(&shown, **fdi, e))
+    });
+    let mut sources = read.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let scans = crate::parallel::parallel_map(&case.scans, |scan| {
+        let path = Case::mesh_path(&loaded.origin, &scan.file);
+        let shown = path.display().to_string();
+        let labels_file = match &scan.labels {
+            super::import::Labels::Json(f) => Some(Case::mesh_path(&loaded.origin, f)),
+            _ => None,
+        };
+        let labelled = read_labelled(&path, &scan.labels, labels_file.as_deref())
+            .and_then(|m| check_scan(&m).map(|()| m))
+            .map_err(|e| scan_error(loaded, &shown, e.to_string()))?;
+        let scale = scan.units.mm();
+        Ok::<_, CaseError>(
+            split(&labelled)
+                .into_iter()
+                .map(|(fdi, mesh)| Source {
+                    fdi,
+                    file: scan.file.clone(),
+                    path: shown.clone(),
+                    mesh: mesh.map_vertices(|v| v * scale),
+                    placement: scan.transform,
+                    scanned: true,
+                })
+                .collect::<Vec<_>>(),
+        )
+    });
+    let mut seen: BTreeMap<Fdi, String> = sources.iter().map(|s| (s.fdi, s.path.clone())).collect();
+    for scan in scans {
+        for s in scan? {
+            if let Some(other) = seen.get(&s.fdi) {
+                let what = if case.meshes.0.contains_key(&s.fdi) {
+                    format!("also named in `meshes` ({other})")
+                } else {
+                    format!("also labelled in {other}")
+                };
+                return Err(scan_error(
+                    loaded,
+                    &s.path,
+                    format!(
+                        "tooth {} is labelled here and {what}: give each tooth once",
+                        s.fdi
+                    ),
+                ));
+            }
+            seen.insert(s.fdi, s.path.clone());
+            sources.push(s);
+        }
+    }
+    Ok(sources)
+}
