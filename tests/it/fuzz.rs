@@ -9,7 +9,12 @@ use orthosim::{
     teeth::{
         Dentition,
         arch::ArchCurve,
-        import::{RepairLimits, import_mesh, read_mesh},
+        import::{
+            Labels, RepairLimits, check_scan, import_mesh,
+            orient::{Arranged, orient},
+            read_labelled, read_mesh, split,
+        },
+        labelled_scan::{ScanFormat, labelled_arch, tooth_colour, write_scan},
     },
 };
 use proptest::prelude::*;
@@ -151,5 +156,79 @@ proptest! {
             }
         }));
         prop_assert!(outcome.is_ok(), "panicked on a mutated .{ext} file");
+    }
+}
+
+/// A lower arch as labelled scans in three forms (made once): (mesh extension, mesh bytes, labels,
+/// JSON label bytes).
+fn labelled_files() -> &'static [(&'static str, Vec<u8>, Labels, Vec<u8>)] {
+    static FILES: std::sync::OnceLock<Vec<(&'static str, Vec<u8>, Labels, Vec<u8>)>> =
+        std::sync::OnceLock::new();
+    FILES.get_or_init(|| {
+        let d = normal();
+        let arch = labelled_arch(d, Arch::Lower, 300, 9);
+        let colours = d
+            .teeth
+            .iter()
+            .filter(|t| t.fdi.arch() == Arch::Lower)
+            .map(|t| (tooth_colour(t.fdi), t.fdi))
+            .collect();
+        [
+            (
+                ScanFormat::PlyProperty,
+                "ply",
+                Labels::Property("label".into()),
+            ),
+            (ScanFormat::PlyColours, "ply", Labels::Colours(colours)),
+            (
+                ScanFormat::ObjJson,
+                "obj",
+                Labels::Json("labels.json".into()),
+            ),
+        ]
+        .into_iter()
+        .map(|(format, ext, labels)| {
+            let (mesh, json) = write_scan(&arch, &arch.mesh, format);
+            (ext, mesh, labels, json.unwrap_or_default())
+        })
+        .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(100))]
+
+    #[test]
+    fn mutated_labelled_scans_never_panic(which in 0usize..3, muts in mutations(), json in any::<bool>()) {
+        let (ext, mesh, labels, label_bytes) = &labelled_files()[which];
+        let (mesh, label_bytes) = if json && *ext == "obj" {
+            (mesh.clone(), mutate(label_bytes, &muts))
+        } else {
+            (mutate(mesh, &muts), label_bytes.clone())
+        };
+        let dir = std::env::temp_dir().join(format!("orthosim-fuzz-scan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(format!("lower.{ext}"));
+        let label_path = dir.join("labels.json");
+        std::fs::write(&path, &mesh).unwrap();
+        std::fs::write(&label_path, &label_bytes).unwrap();
+        let outcome = catch_unwind(AssertUnwindSafe(|| {
+            match read_labelled(&path, labels, Some(&label_path)).and_then(|s| check_scan(&s).map(|()| s)) {
+                Err(e) => one_line(&e),
+                Ok(scan) => {
+                    let teeth = split(&scan);
+                    let pairs: Vec<(Fdi, &orthosim::geometry::TriMesh)> =
+                        teeth.iter().map(|(f, m)| (*f, m)).collect();
+                    let d = normal();
+                    if let Err(e) = orient(&pairs, |fdi| {
+                        let t = d.tooth(fdi).unwrap();
+                        Arranged { mesh: &t.geometry.mesh, pose: t.pose }
+                    }) {
+                        one_line(&e);
+                    }
+                }
+            }
+        }));
+        prop_assert!(outcome.is_ok(), "panicked on a mutated labelled .{ext} scan");
     }
 }

@@ -363,3 +363,25 @@ fn closed_teeth_files_of_one_frame_keep_their_relative_pose() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn two_mislabelled_teeth_do_not_tilt_the_placement() {
+    let d = normal();
+    let lower = labelled_arch(&d, Arch::Lower, 700, 6);
+    let frame = ScannerFrame::random(77);
+    let mut teeth = teeth_in(&frame, &[&lower]);
+    // The segmentation swapped the canines' labels.
+    let (c3, c4) = (Fdi::new(33).unwrap(), Fdi::new(43).unwrap());
+    for (f, _) in &mut teeth {
+        *f = if *f == c3 {
+            c4
+        } else if *f == c4 {
+            c3
+        } else {
+            *f
+        };
+    }
+    let found = place(&d, &teeth).unwrap();
+    let (mm, deg) = error(&d, &found, &frame);
+    assert!(mm <= 0.5 && deg <= 2.0, "{mm} mm, {deg}°");
+}

@@ -509,3 +509,62 @@ pub fn check_raw(m: &TriMesh) -> Result<(), ImportError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("orthosim-labels-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    const HEAD: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
+
+    #[test]
+    fn per_face_properties_and_colours_label_their_triangles() {
+        let ply = format!(
+            "{HEAD}element face 2\nproperty list uchar int vertex_indices\nproperty int label\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 11 200 0 0\n3 0 2 3 0 9 9 9\n"
+        );
+        let path = write("faces.ply", &ply);
+        let by_property = read_labelled(&path, &Labels::Property("label".into()), None).unwrap();
+        let eleven = Fdi::new(11).ok();
+        assert_eq!(by_property.labels, vec![eleven, None]);
+        let colours = Labels::Colours([((200, 0, 0), Fdi::new(11).unwrap())].into());
+        let by_colour = read_labelled(&path, &colours, None).unwrap();
+        assert_eq!(by_colour.labels, vec![eleven, None]);
+        let teeth = split(&by_property);
+        assert_eq!(teeth.len(), 1);
+        assert_eq!(teeth[&Fdi::new(11).unwrap()].triangles.len(), 1);
+        let e = read_labelled(&path, &Labels::Property("tooth".into()), None).unwrap_err();
+        assert!(e.to_string().contains("`tooth`"), "{e}");
+    }
+
+    #[test]
+    fn per_vertex_labels_vote_and_bad_numbers_are_named() {
+        let ply = format!(
+            "{HEAD}property int label\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0 21\n1 0 0 21\n1 1 0 0\n0 1 0 22\n3 0 1 2\n3 0 2 3\n"
+        );
+        let path = write("vertices.ply", &ply);
+        let scan = read_labelled(&path, &Labels::Property("label".into()), None).unwrap();
+        // Two corners of 21: 21; all three different: gum.
+        assert_eq!(scan.labels, vec![Fdi::new(21).ok(), None]);
+        let bad = ply.replace("0 1 0 22", "0 1 0 19");
+        let path = write("bad.ply", &bad);
+        let e = read_labelled(&path, &Labels::Property("label".into()), None).unwrap_err();
+        assert!(e.to_string().contains("label 19 of vertex 3"), "{e}");
+        // OBJ with vertex colours (0–1 floats), faces with texture indices and negative indices.
+        let obj = write(
+            "colours.obj",
+            "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 1 1 0 1 0 0\nv 0 1 0 0 1 0\nf 1/1 2/2 3/3\nf -4 -2 -1\n",
+        );
+        let colours = Labels::Colours([((255, 0, 0), Fdi::new(31).unwrap())].into());
+        let scan = read_labelled(&obj, &colours, None).unwrap();
+        assert_eq!(scan.labels, vec![Fdi::new(31).ok(), Fdi::new(31).ok()]);
+        let e = read_labelled(&obj, &Labels::Property("label".into()), None).unwrap_err();
+        assert!(e.to_string().contains("PLY"), "{e}");
+    }
+}

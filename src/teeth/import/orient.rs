@@ -14,6 +14,9 @@
 //!    within [`CAP_DEPTH_MM`] of its occlusal end, the end taken below the top 0.5 % of its area so
 //!    spikes do not count) against the arranged tooth's cap, matched again. Caps are where crowns
 //!    agree whatever the gum line, holes or loose pieces of a scan.
+//!    In the last round, teeth whose caps stay more than [`OUTLIER_MM`] (and three times the
+//!    median) from their place are left out and the rest fitted again: a mislabelled tooth or one
+//!    far out of line does not tilt the whole patient.
 //! 3. **Checked**: every crown's own occlusal direction (from its margin to its surface, or from
 //!    root to crown for a closed tooth) must point to the other arch after placement. A mirrored
 //!    scan (left and right swapped relative to its labels) can only be matched by turning the arch
@@ -40,6 +43,9 @@ pub const REFERENCE_RESOLUTION: ToothResolution = ToothResolution { vertices: 15
 pub const CAP_DEPTH_MM: f32 = 1.5;
 /// The largest root-mean-square distance (mm) between matched caps accepted for a placement.
 pub const MAX_RMS_MM: f32 = 6.0;
+/// A tooth whose cap stays farther than this (and than three times the median) from its place
+/// after the fit is left out of the last fit (mm).
+pub const OUTLIER_MM: f32 = 1.5;
 /// Fewest teeth a frame can be found from.
 pub const MIN_TEETH: usize = 3;
 
@@ -126,7 +132,7 @@ pub fn orient<'a>(
     }
     let mut pose = fit(&pairs);
     let mut rms = 0.0;
-    for _ in 0..3 {
+    for round in 0..3 {
         pairs.clear();
         for ((fdi, mesh), r) in teeth.iter().zip(&references) {
             let up = super::occlusal_direction(fdi.arch());
@@ -138,6 +144,26 @@ pub fn orient<'a>(
             pairs.push((c, r.pose.transform_point(rc)));
         }
         pose = fit(&pairs);
+        // Last round: teeth far off the others' fit (a mislabelled or half-segmented tooth, a
+        // patient's tooth out of line) are left out and the rest fitted again.
+        if round == 2 && pairs.len() > MIN_TEETH + 1 {
+            let residual = |p: &(Vec3, Vec3)| pose.transform_point(p.0).distance(p.1);
+            let mut sorted: Vec<f32> = pairs.iter().map(residual).collect();
+            sorted.sort_by(f32::total_cmp);
+            let limit = (3.0 * sorted[sorted.len() / 2]).max(OUTLIER_MM);
+            let kept: Vec<(Vec3, Vec3)> = pairs
+                .iter()
+                .copied()
+                .filter(|p| residual(p) <= limit)
+                .collect();
+            if kept.len() >= MIN_TEETH
+                && kept.len() < pairs.len()
+                && spread(&kept.iter().map(|p| p.1).collect::<Vec<_>>())
+            {
+                pairs = kept;
+                pose = fit(&pairs);
+            }
+        }
         rms = (pairs
             .iter()
             .map(|(a, b)| pose.transform_point(*a).distance_squared(*b))
