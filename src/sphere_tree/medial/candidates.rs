@@ -124,10 +124,55 @@ pub(super) fn candidates(
             cost: columns.outside_volume(&sphere),
         });
     };
-    for (i, _) in covered.iter().enumerate().filter(|(_, c)| !**c) {
-        let e = Sphere::enclosing(&pieces.corners[i]);
-        let sphere = Sphere::new(e.centre, padded(reach(&pieces.corners[i], e.centre)));
-        add(&mut out, sphere, &mut std::iter::once(i as u32));
+    // A piece is poorly covered when no medial candidate reaches it, or only ones whose outside
+    // volume exceeds half a sphere of the leaf spacing (a ball from a seed whose surface around
+    // it is too thin or twisted for a medial ball).
+    let poor = 0.5 * 4.0 / 3.0 * std::f64::consts::PI * f64::from(s).powi(3);
+    let mut cheapest = vec![f64::INFINITY; pieces.corners.len()];
+    for x in &out.list {
+        for &i in &out.pool[x.first as usize..(x.first + x.len) as usize] {
+            let c = &mut cheapest[i as usize];
+            *c = c.min(x.cost);
+        }
+    }
+    let uncovered: Vec<u32> = (0..pieces.corners.len() as u32)
+        .filter(|&i| !covered[i as usize] || cheapest[i as usize] > poor)
+        .collect();
+    for &i in &uncovered {
+        let corners = &pieces.corners[i as usize];
+        let e = Sphere::enclosing(corners);
+        let sphere = Sphere::new(e.centre, padded(reach(corners, e.centre)));
+        add(&mut out, sphere, &mut std::iter::once(i));
+    }
+    // Where medial balls fail (a generated root's narrow apex, a scan's slivers), the poorly
+    // covered pieces are also offered in clusters: one sphere around those of each grid cell of
+    // the leaf spacing and of twice it, so that such a region costs a few leaves, not one per
+    // piece (with a leaf per piece the budget is only met by the sphere around everything).
+    for cell in [s, 2.0 * s] {
+        let mut groups: std::collections::BTreeMap<[i32; 3], Vec<u32>> = Default::default();
+        for &i in &uncovered {
+            let key = (pieces.centroid[i as usize] / cell)
+                .floor()
+                .as_ivec3()
+                .to_array();
+            groups.entry(key).or_default().push(i);
+        }
+        for members in groups.values().filter(|m| m.len() > 1) {
+            let points: Vec<glam::Vec3> = members
+                .iter()
+                .flat_map(|&i| pieces.corners[i as usize])
+                .collect();
+            let e = Sphere::enclosing(&points);
+            let r = points
+                .iter()
+                .map(|p| p.distance(e.centre))
+                .fold(0.0f32, f32::max);
+            add(
+                &mut out,
+                Sphere::new(e.centre, padded(r)),
+                &mut members.iter().copied(),
+            );
+        }
     }
     let all = Sphere::enclosing(&m.mesh.vertices);
     let all = Sphere::new(all.centre, padded(all.radius));

@@ -188,9 +188,18 @@ pub(super) fn greedy(c: &Candidates, index: &GainIndex, lambda: f64) -> Vec<u32>
 pub(super) fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32> {
     const RUNS: usize = 10;
     let index = GainIndex::new(c, area);
+    // The over-budget cover with the fewest spheres, for when the budget is met only past a
+    // cliff (see the end).
+    let smallest_over: std::cell::RefCell<Option<Vec<u32>>> = Default::default();
     let run = |lambda: f64| {
         let mut chosen = greedy(c, &index, lambda);
         prune(c, &mut chosen, area.len());
+        if chosen.len() > max_leaves {
+            let mut over = smallest_over.borrow_mut();
+            if over.as_ref().is_none_or(|o| chosen.len() < o.len()) {
+                *over = Some(chosen.clone());
+            }
+        }
         chosen
     };
     let target = max_leaves as f64 * 0.985;
@@ -272,6 +281,18 @@ pub(super) fn choose(c: &Candidates, area: &[f32], max_leaves: usize) -> Vec<u32
                 lo = mid;
             }
         }
+    }
+    // A cliff: where medial balls cover the surface poorly, the cover can jump from over the
+    // budget straight to the one sphere around everything as λ grows. Then the smallest cover
+    // over the budget is kept instead, if it is within twice the budget: the builder drops the
+    // spheres holding the least surface down to the budget and the exact cover gives their
+    // surface to the others.
+    if max_leaves >= 64
+        && best.len() * 4 < max_leaves
+        && let Some(over) = smallest_over.into_inner()
+        && over.len() <= 2 * max_leaves
+    {
+        return over;
     }
     best
 }
