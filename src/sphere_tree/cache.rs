@@ -21,7 +21,7 @@ use crate::{
 };
 
 /// Changes whenever a builder's output changes for the same mesh and settings.
-pub const BUILDER_VERSION: u32 = 13;
+pub const BUILDER_VERSION: u32 = 14;
 
 /// A directory of cached trees.
 #[derive(Clone, Debug, PartialEq, Eq)]

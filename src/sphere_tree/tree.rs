@@ -97,6 +97,42 @@ pub fn triangles_touching(mesh: &TriMesh, s: &Sphere) -> Vec<u32> {
         .collect()
 }
 
+/// [`triangles_touching`] through the mesh's triangle hierarchy (the same triangles, in the same
+/// ascending order), for trees of large meshes.
+pub fn triangles_touching_bvh(
+    mesh: &TriMesh,
+    bvh: &crate::geometry::TriangleBvh,
+    s: &Sphere,
+) -> Vec<u32> {
+    let reach2 = s.radius * s.radius * (1.0 + 1e-4) + 1e-12;
+    let mut out = Vec::new();
+    let mut stack = Vec::with_capacity(64);
+    if !bvh.nodes.is_empty() {
+        stack.push(0usize);
+    }
+    while let Some(n) = stack.pop() {
+        let node = &bvh.nodes[n];
+        if node.aabb.distance_squared_to_point(s.centre) > reach2 {
+            continue;
+        }
+        if node.is_leaf() {
+            for &t in bvh.leaf_triangles(node) {
+                let [a, b, c] = mesh.triangle(t as usize);
+                if Aabb::from_points([a, b, c]).distance_squared_to_point(s.centre) <= reach2
+                    && s.contains(closest_point_triangle(s.centre, a, b, c))
+                {
+                    out.push(t);
+                }
+            }
+        } else {
+            stack.push(node.start as usize);
+            stack.push(node.start as usize + 1);
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -128,12 +128,20 @@ pub(super) fn candidates(
     // volume exceeds half a sphere of the leaf spacing (a ball from a seed whose surface around
     // it is too thin or twisted for a medial ball).
     let poor = 0.5 * 4.0 / 3.0 * std::f64::consts::PI * f64::from(s).powi(3);
+    // A ball's candidates cover nested prefixes of one run and grow dearer, so each piece's
+    // cheapest candidate of a ball is the first whose prefix holds it.
     let mut cheapest = vec![f64::INFINITY; pieces.corners.len()];
+    let mut previous: Option<(u32, u32)> = None;
     for x in &out.list {
-        for &i in &out.pool[x.first as usize..(x.first + x.len) as usize] {
+        let from = match previous {
+            Some((first, len)) if first == x.first && len <= x.len => len,
+            _ => 0,
+        };
+        for &i in &out.pool[(x.first + from) as usize..(x.first + x.len) as usize] {
             let c = &mut cheapest[i as usize];
             *c = c.min(x.cost);
         }
+        previous = Some((x.first, x.len));
     }
     let uncovered: Vec<u32> = (0..pieces.corners.len() as u32)
         .filter(|&i| !covered[i as usize] || cheapest[i as usize] > poor)

@@ -5,8 +5,8 @@ use glam::Vec3;
 
 use super::padded;
 use crate::{
-    geometry::{Aabb, Sphere, TriMesh},
-    sphere_tree::tree::{SphereTree, triangles_touching},
+    geometry::{Aabb, Sphere, TriMesh, TriangleBvh},
+    sphere_tree::tree::{SphereTree, triangles_touching_bvh},
 };
 
 /// Places `group` (leaf indices) at slot `node` of `level`: a single leaf sits in the slot itself;
@@ -21,11 +21,12 @@ pub(super) fn place(
     leaves: &[Sphere],
     corners: &[Vec<Vec3>],
     mesh: &TriMesh,
+    bvh: &TriangleBvh,
 ) {
     if group.len() == 1 || level + 1 >= tree.levels {
         let i = group[0];
         tree.nodes[node] = Some(leaves[i]);
-        tree.triangles[node] = triangles_touching(mesh, &leaves[i]);
+        tree.triangles[node] = triangles_touching_bvh(mesh, bvh, &leaves[i]);
         return;
     }
     let points: Vec<Vec3> = group
@@ -38,7 +39,7 @@ pub(super) fn place(
     let first = tree.children(node).start;
     for (k, part) in parts.into_iter().enumerate() {
         if !part.is_empty() {
-            place(tree, first + k, level + 1, part, leaves, corners, mesh);
+            place(tree, first + k, level + 1, part, leaves, corners, mesh, bvh);
         }
     }
 }

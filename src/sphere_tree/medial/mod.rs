@@ -17,7 +17,10 @@
 //!    (`Columns`, all margins of a ball in one pass over the lines, skipping lines whose chord
 //!    through the largest margin lies inside the tooth). A tiny sphere around each piece no
 //!    candidate covers, and the smallest sphere around the whole mesh, keep the cover always
-//!    feasible.
+//!    feasible. Pieces that no candidate reaches, or only ones whose outside volume exceeds half a
+//!    sphere of the leaf spacing (where medial balls fail: a generated root's narrow apex, a
+//!    scan's slivers), are also offered as spheres of their own and in clusters by grid cells of
+//!    s and 2s, so that such a region costs a few leaves rather than one per piece.
 //! 4. **Cover.** Greedy weighted set cover (the most newly covered area per (outside volume + λ)),
 //!    evaluated lazily over exact integer gains that are kept current as pieces are covered
 //!    (`GainIndex`: a ball's margins share increments, each piece lists the increments that
@@ -26,7 +29,9 @@
 //!    leaf; λ is searched (from a guess predicted by each ball's best candidate alone, then on
 //!    log λ against log size) so that the cover just fits 8 % over the budget B^(levels−1):
 //!    polishing leaves a few spheres with no surface of their own, and step 6 drops any leaves
-//!    still over the budget.
+//!    still over the budget. Should the cover still jump, as λ grows, from over the budget to a
+//!    handful of spheres (under a quarter of a budget of 64 or more), the smallest cover over the
+//!    budget (at most twice it) is kept, and step 6 trims it.
 //! 5. **Shrink and polish.** The cover is decided on pieces; the spheres are then tightened on a
 //!    lattice of 10 points per piece: each point goes to the sphere that holds it with the most
 //!    room, each sphere shrinks to its points (radii only shrink, so the points stay covered), and
@@ -63,7 +68,7 @@
 //! leaves. Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
-//! 0.078 (0.060–0.100), about 510 leaves; see the README for the table and the build times.
+//! 0.077 (0.060–0.098), about 510 leaves; see the README for the table and the build times.
 
 //!
 //! One file per phase: `pieces` (pieces, seeds and the point lattice), `balls` (medial balls),
@@ -268,8 +273,13 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         .iter()
         .map(|&o| index.get(o as usize).copied().unwrap_or(u32::MAX))
         .collect();
-    let (leaves, corners) = cover_exact(kept, &pieces, &hint, (&lattice_owner, lattice.len), s);
+    let (leaves, mut corners) = cover_exact(kept, &pieces, &hint, (&lattice_owner, lattice.len), s);
+    // Pieces share corners: each leaf's distinct ones are enough for the inner spheres.
+    for points in &mut corners {
+        points.sort_unstable_by_key(|p| p.to_array().map(f32::to_bits));
+        points.dedup_by_key(|p| p.to_array().map(f32::to_bits));
+    }
     let order: Vec<usize> = (0..leaves.len()).collect();
-    place(&mut tree, 0, 0, order, &leaves, &corners, mesh);
+    place(&mut tree, 0, 0, order, &leaves, &corners, mesh, bvh);
     tree
 }
