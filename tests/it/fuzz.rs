@@ -159,11 +159,12 @@ proptest! {
     }
 }
 
-/// A lower arch as labelled scans in three forms (made once): (mesh extension, mesh bytes, labels,
-/// JSON label bytes).
-fn labelled_files() -> &'static [(&'static str, Vec<u8>, Labels, Vec<u8>)] {
-    static FILES: std::sync::OnceLock<Vec<(&'static str, Vec<u8>, Labels, Vec<u8>)>> =
-        std::sync::OnceLock::new();
+/// A labelled scan file: mesh extension, mesh bytes, labels, JSON label bytes.
+type ScanFiles = (&'static str, Vec<u8>, Labels, Vec<u8>);
+
+/// A lower arch as labelled scans in three forms (made once).
+fn labelled_files() -> &'static [ScanFiles] {
+    static FILES: std::sync::OnceLock<Vec<ScanFiles>> = std::sync::OnceLock::new();
     FILES.get_or_init(|| {
         let d = normal();
         let arch = labelled_arch(d, Arch::Lower, 300, 9);

@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::padded;
 use crate::{
-    geometry::{Aabb, Sphere, TriMesh, TriangleBvh},
+    geometry::{Aabb, MeshRef, Sphere},
     sphere_tree::tree::{SphereTree, triangles_touching_bvh},
 };
 
@@ -20,13 +20,12 @@ pub(super) fn place(
     mut group: Vec<usize>,
     leaves: &[Sphere],
     corners: &[Vec<Vec3>],
-    mesh: &TriMesh,
-    bvh: &TriangleBvh,
+    m: MeshRef,
 ) {
     if group.len() == 1 || level + 1 >= tree.levels {
         let i = group[0];
         tree.nodes[node] = Some(leaves[i]);
-        tree.triangles[node] = triangles_touching_bvh(mesh, bvh, &leaves[i]);
+        tree.triangles[node] = triangles_touching_bvh(m.mesh, m.bvh, &leaves[i]);
         return;
     }
     let points: Vec<Vec3> = group
@@ -39,7 +38,7 @@ pub(super) fn place(
     let first = tree.children(node).start;
     for (k, part) in parts.into_iter().enumerate() {
         if !part.is_empty() {
-            place(tree, first + k, level + 1, part, leaves, corners, mesh, bvh);
+            place(tree, first + k, level + 1, part, leaves, corners, m);
         }
     }
 }

@@ -280,6 +280,6 @@ fn build(mesh: &TriMesh, bvh: &TriangleBvh, branching: u32, levels: u32) -> Sphe
         points.dedup_by_key(|p| p.to_array().map(f32::to_bits));
     }
     let order: Vec<usize> = (0..leaves.len()).collect();
-    place(&mut tree, 0, 0, order, &leaves, &corners, mesh, bvh);
+    place(&mut tree, 0, 0, order, &leaves, &corners, m);
     tree
 }
