@@ -74,41 +74,7 @@ fn trace(m: &DMat3) -> f64 {
 /// Eigen-decomposition of a symmetric 3×3 matrix by cyclic Jacobi rotations: eigenvalues ascending,
 /// eigenvectors as the columns of the returned matrix (a proper rotation).
 pub fn symmetric_eigen(m: DMat3) -> (DVec3, DMat3) {
-    let mut a = m.to_cols_array_2d();
-    let mut v = DMat3::IDENTITY.to_cols_array_2d();
-    for _ in 0..64 {
-        let off = a[0][1].powi(2) + a[0][2].powi(2) + a[1][2].powi(2);
-        if off <= 1e-30 * (a[0][0].powi(2) + a[1][1].powi(2) + a[2][2].powi(2)).max(1e-300) {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q].abs() < 1e-300 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let t = if theta == 0.0 { 1.0 } else { t };
-            let c = 1.0 / (t * t + 1.0).sqrt();
-            let s = t * c;
-            // A' = Jᵀ A J with J the rotation in the (p, q) plane.
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = c * akp - s * akq;
-                a[k][q] = s * akp + c * akq;
-            }
-            for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
-            }
-            for k in 0..3 {
-                let (vkp, vkq) = (v[p][k], v[q][k]);
-                v[p][k] = c * vkp - s * vkq;
-                v[q][k] = s * vkp + c * vkq;
-            }
-        }
-    }
-    let values = [a[0][0], a[1][1], a[2][2]];
+    let (values, v) = jacobi_eigen(m.to_cols_array_2d());
     let mut idx = [0usize, 1, 2];
     idx.sort_by(|&i, &j| values[i].total_cmp(&values[j]));
     let mut cols = idx.map(|i| DVec3::from(v[i]));
@@ -119,6 +85,62 @@ pub fn symmetric_eigen(m: DMat3) -> (DVec3, DMat3) {
         DVec3::new(values[idx[0]], values[idx[1]], values[idx[2]]),
         DMat3::from_cols(cols[0], cols[1], cols[2]),
     )
+}
+
+/// Eigenvalues and unit eigenvectors (`vectors[i]` belongs to `values[i]`, unsorted) of a symmetric
+/// N×N matrix by cyclic Jacobi rotations, until the off-diagonal part is below 10⁻¹⁵ of the
+/// diagonal (relative) or after 64 sweeps.
+pub fn jacobi_eigen<const N: usize>(mut a: [[f64; N]; N]) -> ([f64; N], [[f64; N]; N]) {
+    let mut v = [[0.0; N]; N];
+    for (i, row) in v.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for _ in 0..64 {
+        let mut off = 0.0;
+        let mut diagonal = 0.0;
+        for p in 0..N {
+            diagonal += a[p][p].powi(2);
+            for q in p + 1..N {
+                off += a[p][q].powi(2);
+            }
+        }
+        if off <= 1e-30 * f64::max(diagonal, 1e-300) {
+            break;
+        }
+        for p in 0..N {
+            for q in p + 1..N {
+                if a[p][q].abs() < 1e-300 {
+                    continue;
+                }
+                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                // A' = Jᵀ A J with J the rotation in the (p, q) plane.
+                for row in a.iter_mut() {
+                    let (akp, akq) = (row[p], row[q]);
+                    row[p] = c * akp - s * akq;
+                    row[q] = s * akp + c * akq;
+                }
+                for k in 0..N {
+                    let (apk, aqk) = (a[p][k], a[q][k]);
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for k in 0..N {
+                    let (vkp, vkq) = (v[p][k], v[q][k]);
+                    v[p][k] = c * vkp - s * vkq;
+                    v[q][k] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    let mut values = [0.0; N];
+    for (i, value) in values.iter_mut().enumerate() {
+        *value = a[i][i];
+    }
+    (values, v)
 }
 
 #[cfg(test)]

@@ -28,7 +28,7 @@ pub use closest::{
     triangle_plane_gap, triangles_intersect,
 };
 pub(crate) use columns::{Columns, LocalLines};
-pub use mass::MassProperties;
+pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
 pub use mesh_distance::{
     MeshRef, MeshSeparation, NearContact, closest_point_on_mesh, closest_point_on_mesh_within,
     closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation, point_inside_mesh,

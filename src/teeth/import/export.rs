@@ -65,17 +65,7 @@ pub fn export_case_as(
     dir: &Path,
     meshes_as: ExportMeshes,
 ) -> Result<ExportReport, OutputError> {
-    let source = Path::new(&d.case.origin);
-    let mut case: Case = d.case.case.clone();
-    let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
-    // Never replace what is read: the case file and its mesh files.
-    let mut inputs = vec![source.to_owned()];
-    inputs.extend(
-        case.meshes
-            .0
-            .values()
-            .map(|m| Case::mesh_path(&d.case.origin, &m.file)),
-    );
+    let (mut case, case_file, inputs) = export_start(d, dir);
     let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let meshes: Vec<PathBuf> = d
         .teeth
@@ -166,16 +156,7 @@ pub fn export_labelled_scans(
     seed: u64,
     format: ScanFormat,
 ) -> Result<(ExportReport, ScannerFrame), OutputError> {
-    let source = Path::new(&d.case.origin);
-    let mut case: Case = d.case.case.clone();
-    let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
-    let mut inputs = vec![source.to_owned()];
-    inputs.extend(
-        case.meshes
-            .0
-            .values()
-            .map(|m| Case::mesh_path(&d.case.origin, &m.file)),
-    );
+    let (mut case, case_file, inputs) = export_start(d, dir);
     let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let extension = match format {
         ScanFormat::ObjJson => "obj",
@@ -261,6 +242,28 @@ pub fn export_labelled_scans(
         },
         frame,
     ))
+}
+
+/// The case to write, its file in `dir`, and the files it was read from (never replaced: the
+/// case file, its mesh files and its scans with their label files).
+fn export_start(d: &Dentition, dir: &Path) -> (Case, PathBuf, Vec<PathBuf>) {
+    let case: Case = d.case.case.clone();
+    let case_file = dir.join(format!("{}.ron", file_stem(&case.name)));
+    let origin = &d.case.origin;
+    let mut inputs = vec![PathBuf::from(origin)];
+    inputs.extend(
+        case.meshes
+            .0
+            .values()
+            .map(|m| Case::mesh_path(origin, &m.file)),
+    );
+    for scan in &case.scans {
+        inputs.push(Case::mesh_path(origin, &scan.file));
+        if let Labels::Json(file) = &scan.labels {
+            inputs.push(Case::mesh_path(origin, file));
+        }
+    }
+    (case, case_file, inputs)
 }
 
 fn file_stem(name: &str) -> String {

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     error::ImportError,
-    read::{MeshFormat, malformed, read_mesh},
+    read::{MeshFormat, malformed, ply_scalar, read_mesh},
 };
 use crate::{
     geometry::TriMesh,
@@ -274,29 +274,17 @@ fn read_ply_attributes(path: &Path, labels: &Labels) -> Result<RawScan, ImportEr
         .read_ply(&mut std::io::BufReader::new(file))
         .map_err(|e| malformed(MeshFormat::Ply, e))?;
     let (mesh, face_of_triangle) = super::read::ply_mesh(&ply)?;
+    // Integers, and floats that hold whole numbers (some tools write labels as floats).
     let integer = |p: &Property| -> Option<i64> {
-        Some(match *p {
-            Property::Char(v) => v as i64,
-            Property::UChar(v) => v as i64,
-            Property::Short(v) => v as i64,
-            Property::UShort(v) => v as i64,
-            Property::Int(v) => v as i64,
-            Property::UInt(v) => v as i64,
-            Property::Float(v) if v.fract() == 0.0 && v.abs() < 1e9 => v as i64,
-            Property::Double(v) if v.fract() == 0.0 && v.abs() < 1e9 => v as i64,
-            _ => return None,
-        })
+        let v = ply_scalar(p)?;
+        (v.fract() == 0.0 && v.abs() < 1e9).then_some(v as i64)
     };
+    // Colour channels: integers (0–255) or floats (0–1, or 0–255).
     let channel = |p: &Property| -> Option<u8> {
-        Some(match *p {
-            Property::UChar(v) => v,
-            Property::Char(v) => v as u8,
-            Property::UShort(v) => v.min(255) as u8,
-            Property::Int(v) => v.clamp(0, 255) as u8,
-            Property::UInt(v) => v.min(255) as u8,
-            Property::Float(v) => colour_channel(v),
-            Property::Double(v) => colour_channel(v as f32),
-            _ => return None,
+        let v = ply_scalar(p)?;
+        Some(match p {
+            Property::Float(_) | Property::Double(_) => colour_channel(v as f32),
+            _ => v.clamp(0.0, 255.0) as u8,
         })
     };
     let elements = |name: &str| ply.payload.get(name).map(Vec::as_slice).unwrap_or(&[]);

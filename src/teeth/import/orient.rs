@@ -30,7 +30,7 @@
 use glam::{DMat3, DQuat, DVec3, Quat, Vec3};
 
 use crate::{
-    geometry::{Pose, TriMesh},
+    geometry::{Pose, TriMesh, jacobi_eigen, symmetric_eigen},
     teeth::{fdi::Fdi, shape::ToothResolution},
 };
 
@@ -429,9 +429,9 @@ fn own_occlusal(mesh: &TriMesh) -> Option<Vec3> {
         let d = v.as_dvec3() - mean;
         cov += DMat3::from_cols(d * d.x, d * d.y, d * d.z);
     }
-    let (values, vectors) = symmetric_eigen::<3>(mat3_rows(&cov));
-    let k = (0..3).max_by(|&a, &b| values[a].total_cmp(&values[b]))?;
-    let axis = DVec3::new(vectors[0][k], vectors[1][k], vectors[2][k]).as_vec3();
+    // Eigenvalues ascending: the last column is the longest extent.
+    let (_, vectors) = symmetric_eigen(cov);
+    let axis = vectors.z_axis.as_vec3();
     let (lo, hi) = mesh
         .vertices
         .iter()
@@ -441,15 +441,6 @@ fn own_occlusal(mesh: &TriMesh) -> Option<Vec3> {
         });
     let offset = centroid.dot(axis) - 0.5 * (lo + hi);
     (offset.abs() > 1e-3).then(|| axis * offset.signum())
-}
-
-fn mat3_rows(m: &DMat3) -> [[f64; 3]; 3] {
-    let r = m.transpose();
-    [
-        r.x_axis.to_array(),
-        r.y_axis.to_array(),
-        r.z_axis.to_array(),
-    ]
 }
 
 /// True when the points do not all lie near one line (their second principal spread ≥ 1 mm).
@@ -464,9 +455,8 @@ fn spread(points: &[Vec3]) -> bool {
         let d = v.as_dvec3() - mean;
         cov += DMat3::from_cols(d * d.x, d * d.y, d * d.z) / n;
     }
-    let (mut values, _) = symmetric_eigen::<3>(mat3_rows(&cov));
-    values.sort_by(|a, b| b.total_cmp(a));
-    values[1] >= 1.0
+    // Eigenvalues ascending: the middle one is the second spread.
+    symmetric_eigen(cov).0.y >= 1.0
 }
 
 /// The rigid motion taking the first points of the pairs onto the second in the least-squares
@@ -491,11 +481,12 @@ fn fit(pairs: &[(Vec3, Vec3)]) -> Pose {
         [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
         [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
     ];
-    let (values, vectors) = symmetric_eigen::<4>(m);
+    let (values, vectors) = jacobi_eigen(m);
     let k = (0..4)
         .max_by(|&a, &b| values[a].total_cmp(&values[b]))
         .unwrap_or(0);
-    let q = DQuat::from_xyzw(vectors[1][k], vectors[2][k], vectors[3][k], vectors[0][k]);
+    let [w, x, y, z] = vectors[k];
+    let q = DQuat::from_xyzw(x, y, z, w);
     let q = if q.length() > 0.0 {
         q.normalize()
     } else {
@@ -504,55 +495,6 @@ fn fit(pairs: &[(Vec3, Vec3)]) -> Pose {
     let rotation: Quat = q.as_quat().normalize();
     let t = cb - q * ca;
     Pose::new(rotation, t.as_vec3())
-}
-
-/// Eigenvalues and eigenvectors (columns) of a symmetric matrix by cyclic Jacobi rotations.
-fn symmetric_eigen<const N: usize>(mut a: [[f64; N]; N]) -> ([f64; N], [[f64; N]; N]) {
-    let mut v = [[0.0; N]; N];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    for _ in 0..50 {
-        let off: f64 = (0..N)
-            .flat_map(|i| (0..N).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i][j] * a[i][j])
-            .sum();
-        if off < 1e-22 {
-            break;
-        }
-        for p in 0..N {
-            for q in p + 1..N {
-                if a[p][q].abs() < 1e-300 {
-                    continue;
-                }
-                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for k in 0..N {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for k in 0..N {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for row in v.iter_mut() {
-                    let (vkp, vkq) = (row[p], row[q]);
-                    row[p] = c * vkp - s * vkq;
-                    row[q] = s * vkp + c * vkq;
-                }
-            }
-        }
-    }
-    let mut values = [0.0; N];
-    for (i, value) in values.iter_mut().enumerate() {
-        *value = a[i][i];
-    }
-    (values, v)
 }
 
 /// A transform as the case file writes it: rotation in degrees about x, then y, then z, and the

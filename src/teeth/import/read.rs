@@ -185,24 +185,27 @@ fn read_ply<R: std::io::Read>(reader: &mut R) -> Result<TriMesh, ImportError> {
     ply_mesh(&ply).map(|(mesh, _)| mesh)
 }
 
+/// A PLY scalar property as a number (`None` for a list).
+pub(super) fn ply_scalar(p: &ply_rs_bw::ply::Property) -> Option<f64> {
+    use ply_rs_bw::ply::Property;
+    Some(match *p {
+        Property::Char(v) => v as f64,
+        Property::UChar(v) => v as f64,
+        Property::Short(v) => v as f64,
+        Property::UShort(v) => v as f64,
+        Property::Int(v) => v as f64,
+        Property::UInt(v) => v as f64,
+        Property::Float(v) => v as f64,
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
 /// The mesh of a parsed PLY file, and the face each triangle comes from (polygons become fans).
 pub(super) fn ply_mesh(
     ply: &ply_rs_bw::ply::Ply<ply_rs_bw::ply::DefaultElement>,
 ) -> Result<(TriMesh, Vec<usize>), ImportError> {
     use ply_rs_bw::ply::Property;
-    let scalar = |p: &Property| -> Option<f64> {
-        Some(match *p {
-            Property::Char(v) => v as f64,
-            Property::UChar(v) => v as f64,
-            Property::Short(v) => v as f64,
-            Property::UShort(v) => v as f64,
-            Property::Int(v) => v as f64,
-            Property::UInt(v) => v as f64,
-            Property::Float(v) => v as f64,
-            Property::Double(v) => v,
-            _ => return None,
-        })
-    };
     let list = |p: &Property| -> Option<Vec<i64>> {
         Some(match p {
             Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
@@ -222,9 +225,13 @@ pub(super) fn ply_mesh(
     for (i, v) in vertices.iter().enumerate() {
         let mut xyz = [0.0f32; 3];
         for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
-            let value = v.get(name).and_then(scalar).ok_or(ImportError::PlyContent(
-                PlyProblem::NoCoordinate { vertex: i, name },
-            ))?;
+            let value = v
+                .get(name)
+                .and_then(ply_scalar)
+                .ok_or(ImportError::PlyContent(PlyProblem::NoCoordinate {
+                    vertex: i,
+                    name,
+                }))?;
             xyz[k] = value as f32;
         }
         mesh.vertices.push(Vec3::from_array(xyz));
