@@ -83,6 +83,12 @@ fn case_sources() -> Vec<String> {
             transform: (translation: (0.0, 1.0, 0.0), rotation_deg: (0.0, 0.0, 90.0)))})"#
             .into(),
     );
+    v.push(
+        r#"Case(name: "s", scans: [(file: "lower.ply", labels: Colours({(139, 0, 0): 41, (255, 48, 48): 42}),
+            units: Inches), (file: "upper.obj", labels: Json("upper.json"), transform: Identity)],
+            meshes: {36: (file: "36.stl", transform: Auto)}, loads: [(teeth: [41], force: World(0.0, 0.0, 1.0))])"#
+            .into(),
+    );
     v
 }
 
@@ -90,7 +96,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 
     #[test]
-    fn mutated_case_files_never_panic(which in 0usize..5, muts in mutations()) {
+    fn mutated_case_files_never_panic(which in 0usize..6, muts in mutations()) {
         let sources = case_sources();
         let source = mutate(sources[which % sources.len()].as_bytes(), &muts);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
