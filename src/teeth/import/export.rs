@@ -115,12 +115,7 @@ pub fn export_case_as(
     case.meshes = files;
     case.offsets = ToothMap::default();
     case.bite_opening_mm = Default::default();
-    let text =
-        ron::ser::to_string_pretty(&case, ron::ser::PrettyConfig::default().struct_names(true))
-            .map_err(|e| OutputError::Write {
-                path: case_file.clone(),
-                source: std::io::Error::other(e),
-            })?;
+    let text = case_text(&case, &case_file)?;
     let what = match meshes_as {
         ExportMeshes::Teeth => "one STL per tooth".to_string(),
         ExportMeshes::ScanLike { triangles, seed } => format!(
@@ -220,12 +215,7 @@ pub fn export_labelled_scans(
     case.extracted = Default::default();
     case.offsets = ToothMap::default();
     case.bite_opening_mm = Default::default();
-    let text =
-        ron::ser::to_string_pretty(&case, ron::ser::PrettyConfig::default().struct_names(true))
-            .map_err(|e| OutputError::Write {
-                path: case_file.clone(),
-                source: std::io::Error::other(e),
-            })?;
+    let text = case_text(&case, &case_file)?;
     let header = format!(
         "// Exported by `orthosim export-case --labelled` from {}: each arch one labelled scan of\n\
          // scan-like crowns (about {triangles} triangles each, defects of seed {seed}) and a gum,\n\
@@ -264,6 +254,16 @@ fn export_start(d: &Dentition, dir: &Path) -> (Case, PathBuf, Vec<PathBuf>) {
         }
     }
     (case, case_file, inputs)
+}
+
+/// The case as RON, for `path`.
+fn case_text(case: &Case, path: &Path) -> Result<String, OutputError> {
+    ron::ser::to_string_pretty(case, ron::ser::PrettyConfig::default().struct_names(true)).map_err(
+        |e| OutputError::Write {
+            path: path.to_owned(),
+            source: std::io::Error::other(e),
+        },
+    )
 }
 
 fn file_stem(name: &str) -> String {
