@@ -351,6 +351,65 @@ impl TriMesh {
         (sum / (3 * self.triangles.len().max(1)) as f64) as f32
     }
 
+    /// The pieces of the surface joined along edges (a piece touching another at one vertex only
+    /// is separate): the piece of each triangle, numbered from 0 in order of first triangle, and
+    /// the number of pieces.
+    pub fn edge_pieces(&self) -> (Vec<u32>, usize) {
+        let mut by_edge: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        for (i, t) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                by_edge
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push(i as u32);
+            }
+        }
+        let mut piece = vec![u32::MAX; self.triangles.len()];
+        let mut count = 0;
+        let mut stack = Vec::new();
+        for start in 0..self.triangles.len() {
+            if piece[start] != u32::MAX {
+                continue;
+            }
+            piece[start] = count;
+            stack.push(start);
+            while let Some(i) = stack.pop() {
+                let t = self.triangles[i];
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    for &j in &by_edge[&(a.min(b), a.max(b))] {
+                        if piece[j as usize] == u32::MAX {
+                            piece[j as usize] = count;
+                            stack.push(j as usize);
+                        }
+                    }
+                }
+            }
+            count += 1;
+        }
+        (piece, count as usize)
+    }
+
+    /// The edges used by one triangle only (the openings' edges), as (smaller, larger) vertex
+    /// index, whatever the triangles' winding.
+    pub fn open_edges(&self) -> Vec<(u32, u32)> {
+        let mut count: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut open: Vec<(u32, u32)> = count
+            .into_iter()
+            .filter(|(_, n)| *n == 1)
+            .map(|(e, _)| e)
+            .collect();
+        open.sort_unstable();
+        open
+    }
+
     /// The same surface without the vertices no triangle uses (the rest keep their order).
     pub fn without_unused_vertices(&self) -> Self {
         let mut map = vec![u32::MAX; self.vertices.len()];

@@ -134,25 +134,21 @@ impl Dentition {
         let mut orientation = Vec::new();
         if let Some(patient) = patient {
             // Each imported tooth's buccal axis comes from the arch as it is: the arrangement's
-            // forms fitted to the cervical centres of the teeth present, imported ones framed on
-            // the arrangement's curves first.
+            // forms fitted to the cervical centres of the teeth present. An imported tooth's
+            // cervical centre (its frame's origin) does not depend on the curve, so any curve
+            // places it for the fit.
             let provisional = arch_forms.map(|f| ArchCurve::new(&f));
             fn curve_of(curves: &[ArchCurve; 2], f: Fdi) -> &ArchCurve {
                 &curves[usize::from(f.arch() == Arch::Lower)]
             }
-            let framed: Vec<_> = patient
-                .teeth
-                .iter()
-                .map(|(f, _, p)| p.frame(*f, curve_of(&provisional, *f)))
-                .collect();
-            for ((f, _, _), t) in patient.teeth.iter().zip(&framed) {
+            for (f, prepared) in &patient.teeth {
                 if let Some(placed) = teeth.iter_mut().find(|t| t.fdi == *f) {
-                    placed.pose = t.pose;
+                    placed.pose = prepared.pose(*f, curve_of(&provisional, *f));
                 }
             }
             arch_forms = fitted_forms(&teeth, arch_forms);
             let fitted = arch_forms.map(|f| ArchCurve::new(&f));
-            for (f, _, prepared) in &patient.teeth {
+            for (f, prepared) in &patient.teeth {
                 let tooth = prepared.frame(*f, curve_of(&fitted, *f));
                 if let Some(t) = teeth.iter_mut().find(|t| t.fdi == *f) {
                     t.geometry = Arc::new(tooth.geometry);

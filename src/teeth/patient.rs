@@ -53,8 +53,8 @@ struct Source {
 
 /// The patient's teeth of a case, placed and prepared.
 pub(super) struct PatientTeeth {
-    /// Prepared teeth with the file they came from.
-    pub teeth: Vec<(Fdi, String, Prepared)>,
+    /// Prepared teeth.
+    pub teeth: Vec<(Fdi, Prepared)>,
     /// The teeth the scans label.
     pub labelled: Vec<Fdi>,
     /// Where the files went.
@@ -161,7 +161,7 @@ pub(super) fn patient_teeth(
     });
     let mut teeth = Vec::with_capacity(sources.len());
     for (s, p) in sources.iter().zip(prepared) {
-        teeth.push((s.fdi, s.path.clone(), p?));
+        teeth.push((s.fdi, p?));
     }
     Ok(PatientTeeth {
         teeth,

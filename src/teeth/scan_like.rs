@@ -10,7 +10,7 @@
 //! where each defect is ([`ScanLikeCrown::sites`]) so a test can check the import changes the
 //! surface only there.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 use glam::Vec3;
 
@@ -237,63 +237,29 @@ fn cut_at_gum_line(mesh: &mut TriMesh, scallop: f32, jitter: f32, rng: &mut Rng)
     });
 }
 
+/// The piece with the most triangles (pieces joined along edges).
 fn largest_piece(mesh: TriMesh) -> TriMesh {
-    // Pieces joined along edges (a piece touching the rest at one vertex is separate).
-    let mut by_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (i, t) in mesh.triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            by_edge.entry((a.min(b), a.max(b))).or_default().push(i);
-        }
+    let (piece, count) = mesh.edge_pieces();
+    let mut sizes = vec![0usize; count];
+    for &p in &piece {
+        sizes[p as usize] += 1;
     }
-    let mut piece = vec![usize::MAX; mesh.triangles.len()];
-    let mut sizes = Vec::new();
-    for start in 0..mesh.triangles.len() {
-        if piece[start] != usize::MAX {
-            continue;
-        }
-        let id = sizes.len();
-        let mut stack = vec![start];
-        piece[start] = id;
-        let mut size = 0;
-        while let Some(i) = stack.pop() {
-            size += 1;
-            let t = mesh.triangles[i];
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                for &j in &by_edge[&(a.min(b), a.max(b))] {
-                    if piece[j] == usize::MAX {
-                        piece[j] = id;
-                        stack.push(j);
-                    }
-                }
-            }
-        }
-        sizes.push(size);
-    }
-    let main = (0..sizes.len()).max_by_key(|&i| sizes[i]).unwrap_or(0);
+    let main = (0..count).max_by_key(|&i| sizes[i]).unwrap_or(0) as u32;
     let triangles = mesh
         .triangles
         .iter()
-        .enumerate()
-        .filter(|(i, _)| piece[*i] == main)
-        .map(|(_, t)| *t)
+        .zip(&piece)
+        .filter(|(_, p)| **p == main)
+        .map(|(t, _)| *t)
         .collect();
     TriMesh::new(mesh.vertices, triangles)
 }
 
 /// Vertices on the open boundary.
 fn boundary_vertices(mesh: &TriMesh) -> HashSet<u32> {
-    let mut directed = HashSet::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            directed.insert((t[k], t[(k + 1) % 3]));
-        }
-    }
-    directed
-        .iter()
-        .filter(|(a, b)| !directed.contains(&(*b, *a)))
-        .flat_map(|&(a, b)| [a, b])
+    mesh.open_edges()
+        .into_iter()
+        .flat_map(|(a, b)| [a, b])
         .collect()
 }
 

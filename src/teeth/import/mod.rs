@@ -336,10 +336,16 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
 }
 
 impl Prepared {
+    /// The pose of the tooth's frame on the arch `curve` (see the module doc), without building
+    /// its geometry.
+    pub fn pose(&self, fdi: Fdi, curve: &ArchCurve) -> Pose {
+        let an = anatomy(fdi.arch(), fdi.kind());
+        tooth_pose(&self.mesh, fdi, curve, self.cervical, an.crown_length)
+    }
+
     /// The tooth framed on the arch `curve` (see the module doc).
     pub fn frame(&self, fdi: Fdi, curve: &ArchCurve) -> ImportedTooth {
-        let an = anatomy(fdi.arch(), fdi.kind());
-        let pose = tooth_pose(&self.mesh, fdi, curve, self.cervical, an.crown_length);
+        let pose = self.pose(fdi, curve);
         let inverse = pose.inverse();
         let local = self.mesh.map_vertices(|v| inverse.transform_point(v));
         let geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);

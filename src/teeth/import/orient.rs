@@ -100,7 +100,8 @@ pub struct Arranged<'a> {
 }
 
 /// Finds where the teeth of one frame go: `teeth` are the raw meshes in the files' frame, in
-/// millimetres; `arranged` gives each tooth of the normal arrangement.
+/// millimetres, with valid indices and finite coordinates ([`super::check_raw`]); `arranged`
+/// gives each tooth of the normal arrangement.
 ///
 /// # Errors
 /// [`OrientError`]: too few teeth, a mirrored scan, labels that do not describe an arch.
@@ -108,11 +109,16 @@ pub fn orient<'a>(
     teeth: &[(Fdi, &TriMesh)],
     arranged: impl Fn(Fdi) -> Arranged<'a>,
 ) -> Result<Orientation, OrientError> {
-    // Welded copies: files that repeat each corner per triangle (STL) still show their openings.
+    // Welded as the import welds (files that repeat each corner per triangle, as STL does, then
+    // show their openings), loose pieces left out.
+    let weld_mm = super::RepairLimits::default().weld_mm;
     let welded: Vec<(Fdi, TriMesh)> = teeth
         .iter()
         .filter(|(_, m)| area_centroid(m, |_| true).is_some())
-        .map(|(f, m)| (*f, largest_piece(&weld_exact(m))))
+        .map(|(f, m)| {
+            let (vertices, triangles) = super::repair::weld(m, weld_mm, &mut Default::default());
+            (*f, largest_piece(&TriMesh::new(vertices, triangles)))
+        })
         .collect();
     let teeth: Vec<(Fdi, &TriMesh)> = welded.iter().map(|(f, m)| (*f, m)).collect();
     if teeth.len() < MIN_TEETH {
@@ -194,93 +200,31 @@ pub fn orient<'a>(
     Ok(Orientation { pose, rms_mm: rms })
 }
 
-/// The connected piece (triangles joined through shared vertices) of largest area: loose
-/// pieces of a scan (debris) would otherwise pull the features.
+/// The piece (triangles joined along edges) of largest area: loose pieces of a scan (debris)
+/// would otherwise pull the features.
 fn largest_piece(mesh: &TriMesh) -> TriMesh {
-    let n = mesh.vertices.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            let p = parent[parent[i as usize] as usize];
-            parent[i as usize] = p;
-            i = p;
-        }
-        i
-    }
-    for t in &mesh.triangles {
-        if t.iter().any(|&v| v as usize >= n) {
-            continue;
-        }
-        let a = root(&mut parent, t[0]);
-        for &v in &t[1..] {
-            let b = root(&mut parent, v);
-            if a != b {
-                parent[b as usize] = a;
-            }
+    let (piece, count) = mesh.edge_pieces();
+    let mut area = vec![0.0f32; count];
+    for (t, &p) in mesh.triangles.iter().zip(&piece) {
+        let corner = |i: u32| mesh.vertices.get(i as usize).copied().unwrap_or(Vec3::NAN);
+        let [a, b, c] = t.map(corner);
+        let t_area = (b - a).cross(c - a).length() * 0.5;
+        if t_area.is_finite() {
+            area[p as usize] += t_area;
         }
     }
-    let mut area: std::collections::HashMap<u32, f32> = std::collections::HashMap::new();
-    let mut piece = Vec::with_capacity(mesh.triangles.len());
-    for t in &mesh.triangles {
-        if t.iter().any(|&v| v as usize >= n) {
-            piece.push(u32::MAX);
-            continue;
-        }
-        let r = root(&mut parent, t[0]);
-        let [a, b, c] = t.map(|v| mesh.vertices[v as usize]);
-        let tri_area = (b - a).cross(c - a).length() * 0.5;
-        if tri_area.is_finite() {
-            *area.entry(r).or_default() += tri_area;
-        }
-        piece.push(r);
-    }
-    let Some(best) = area
-        .iter()
-        .max_by(|a, b| a.1.total_cmp(b.1))
-        .map(|(r, _)| *r)
-    else {
-        return mesh.clone();
-    };
+    let main = (0..count)
+        .max_by(|&a, &b| area[a].total_cmp(&area[b]))
+        .unwrap_or(0) as u32;
     TriMesh::new(
         mesh.vertices.clone(),
         mesh.triangles
             .iter()
             .zip(&piece)
-            .filter(|(_, p)| **p == best)
+            .filter(|(_, p)| **p == main)
             .map(|(t, _)| *t)
             .collect(),
     )
-}
-
-/// The mesh with vertices at exactly the same position merged.
-fn weld_exact(mesh: &TriMesh) -> TriMesh {
-    use std::collections::HashMap;
-    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut out = TriMesh::default();
-    let remap: Vec<u32> = mesh
-        .vertices
-        .iter()
-        .map(|v| {
-            *index
-                .entry(v.to_array().map(f32::to_bits))
-                .or_insert_with(|| {
-                    out.vertices.push(*v);
-                    (out.vertices.len() - 1) as u32
-                })
-        })
-        .collect();
-    out.triangles = mesh
-        .triangles
-        .iter()
-        .filter_map(|t| {
-            Some([
-                *remap.get(t[0] as usize)?,
-                *remap.get(t[1] as usize)?,
-                *remap.get(t[2] as usize)?,
-            ])
-        })
-        .collect();
-    out
 }
 
 /// True for an open crown: its openings together are at least a small margin long.
@@ -290,19 +234,8 @@ fn is_crown(mesh: &TriMesh) -> bool {
 
 /// Total boundary length (mm) and the length-weighted centroid of the boundary edges.
 fn boundary(mesh: &TriMesh) -> (f32, Vec3) {
-    use std::collections::HashMap;
-    let mut count: HashMap<(u32, u32), i32> = HashMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
     let (mut length, mut sum) = (0.0f32, Vec3::ZERO);
-    for ((a, b), n) in count {
-        if n != 1 {
-            continue;
-        }
+    for (a, b) in mesh.open_edges() {
         let (Some(&p), Some(&q)) = (mesh.vertices.get(a as usize), mesh.vertices.get(b as usize))
         else {
             continue;

@@ -196,7 +196,7 @@ pub(super) fn clean(
 
 /// Merges vertices within `tol` of each other (first come keeps its position) and drops the
 /// vertices no triangle uses.
-fn weld(mesh: &TriMesh, tol: f32, repairs: &mut Repairs) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+pub(super) fn weld(mesh: &TriMesh, tol: f32, repairs: &mut Repairs) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let cell = tol.max(1e-9);
     let key = |v: Vec3| (v / cell).floor().as_ivec3();
     let mut grid: HashMap<IVec3, Vec<u32>> = HashMap::new();
