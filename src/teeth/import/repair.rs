@@ -161,25 +161,7 @@ pub(super) fn clean(
     limits: &RepairLimits,
     repairs: &mut Repairs,
 ) -> Result<TriMesh, ImportError> {
-    if mesh.vertices.is_empty() || mesh.triangles.is_empty() {
-        return Err(ImportError::Empty {
-            vertices: mesh.vertices.len(),
-            triangles: mesh.triangles.len(),
-        });
-    }
-    if let Some(i) = mesh.vertices.iter().position(|v| !v.is_finite()) {
-        return Err(ImportError::NonFinite(i));
-    }
-    let n = mesh.vertices.len();
-    for (i, t) in mesh.triangles.iter().enumerate() {
-        if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
-            return Err(ImportError::BadIndex {
-                triangle: i,
-                vertex: v,
-                vertices: n,
-            });
-        }
-    }
+    super::labels::check_raw(mesh)?;
     let (mut vertices, triangles) = weld(mesh, limits.weld_mm, repairs);
     let mut triangles = drop_degenerate(&vertices, triangles, repairs);
     repairs.fin_triangles += mend::drop_fins(&mut triangles);
