@@ -35,6 +35,9 @@ enum Command {
     ExportCase(cli::export_case::ExportCaseArgs),
     /// Build each tooth's sphere tree and report its fit (the paper's relative outside volume).
     Trees(cli::trees::TreesArgs),
+    /// Compare the periodontal-ligament model with published biomechanics (centres of
+    /// resistance and rotation, moment-to-force ratios, displacement, rate of movement).
+    Validate(cli::validate::ValidateArgs),
     /// Measure collision detection: µs per pair query and errors of each method on seeded
     /// near-contact motions of real teeth, and the cost of one full-mouth step.
     Bench(cli::bench::BenchArgs),
@@ -52,6 +55,7 @@ fn main() -> ExitCode {
         Command::ExportCase(args) => cli::export_case::run(args),
         Command::Trees(args) => cli::trees::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Validate(args) => cli::validate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,10 +1,12 @@
 //! Analysis: measures computed from placed teeth (no ECS needed), and the report.
 //!
+//! [`biomechanics`] (`orthosim validate`: the PDL model beside published numbers),
 //! [`inspect`](mod@inspect) (mesh data and gaps of a case as loaded), [`measures`] (distances,
 //! occlusal contacts, IPR limits, Bolton and arch length), [`occlusion`] (overjet, overbite and
 //! molar relation of the teeth present), [`plot`] (the paper's distance figures)
 //! and [`report`] (`orthosim report`: every case under every method, to JSON, CSV, plots and HTML).
 
+pub mod biomechanics;
 pub mod inspect;
 pub mod measures;
 pub mod occlusion;
@@ -17,6 +19,7 @@ use crate::{
     io::OutputError, movement::MovementError, sphere_tree::TreeBuildError, teeth::CaseError,
 };
 
+pub use biomechanics::{Validation, ValidationRow, validate};
 pub use inspect::{InspectReport, inspect};
 pub use occlusion::{MeasuredOcclusion, measure_occlusion};
 pub use report::{ALL_CASES, ReportOptions, Summary, run_report};

@@ -32,6 +32,12 @@ pub fn response() -> impl TypedValueParser<Value = orthosim::movement::Response>
     named(&Response::ALL, Response::name)
 }
 
+/// `--model`: the movement model.
+pub fn model() -> impl TypedValueParser<Value = orthosim::movement::MovementModel> {
+    use orthosim::movement::MovementModel;
+    named(&MovementModel::ALL, MovementModel::name)
+}
+
 /// `--tree`, `--method`: the sphere-tree builder.
 pub fn tree_method() -> impl TypedValueParser<Value = orthosim::sphere_tree::TreeMethod> {
     use orthosim::sphere_tree::TreeMethod;

@@ -15,4 +15,5 @@ pub mod simulate;
 pub mod terminal;
 pub mod tree_args;
 pub mod trees;
+pub mod validate;
 pub mod view;

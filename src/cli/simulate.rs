@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use orthosim::{
     collision::Method,
-    movement::{MovementSettings, Response, SimulationReport, run_case},
+    movement::{MovementModel, MovementSettings, Response, SimulationReport, run_case},
 };
 
 use super::{
@@ -27,6 +27,10 @@ pub struct SimulateArgs {
     /// Collision response.
     #[arg(long, value_parser = choice::response(), default_value_t = Response::Block)]
     pub response: Response,
+    /// Movement model (overrides the settings file's): the periodontal ligament in clinical
+    /// time, or the source paper's.
+    #[arg(long, value_parser = choice::model())]
+    pub model: Option<MovementModel>,
     /// Most steps to run.
     #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     pub max_steps: u64,
@@ -48,6 +52,9 @@ pub fn run(args: SimulateArgs) -> Result<()> {
         None => MovementSettings::default(),
     };
     settings.response = args.response;
+    if let Some(model) = args.model {
+        settings.model = model;
+    }
     let progress = progress_wanted();
     if progress {
         eprint!("building trees…");
@@ -78,11 +85,13 @@ pub fn run(args: SimulateArgs) -> Result<()> {
 
 fn print_table(r: &SimulationReport) {
     println!(
-        "case {}, {} / {}: {} steps, {}",
+        "case {}, {} / {} / {}: {} steps ({:.1} days), {}",
         r.case,
+        r.model,
         r.algorithm,
         r.response,
         r.steps,
+        r.days,
         if r.at_rest {
             "at rest"
         } else {

@@ -12,10 +12,12 @@ pub(crate) mod decimate;
 pub(crate) mod interval;
 pub(crate) mod lanes;
 mod mass;
+mod mat6;
 mod mesh_distance;
 mod pose;
 pub(crate) mod ray;
 pub(crate) mod rng;
+mod section;
 pub(crate) mod sphere;
 mod stars;
 pub(crate) mod trimesh;
@@ -29,11 +31,13 @@ pub use closest::{
 };
 pub(crate) use columns::{Columns, LocalLines};
 pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
+pub use mat6::{Mat6, Vec6, halves, vec6};
 pub use mesh_distance::{
     MeshRef, MeshSeparation, NearContact, closest_point_on_mesh, closest_point_on_mesh_within,
     closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation, point_inside_mesh,
 };
 pub use pose::Pose;
+pub use section::section_loops;
 pub use sphere::Sphere;
 pub use stars::VertexStars;
 pub use trimesh::{MeshError, TriMesh};

@@ -45,6 +45,14 @@ pub enum MovementError {
         /// What is wrong.
         message: String,
     },
+    /// A tooth's root cannot carry a periodontal ligament.
+    #[error("tooth {fdi}: {source}")]
+    Pdl {
+        /// The tooth.
+        fdi: Fdi,
+        /// Why.
+        source: crate::movement::pdl::PdlError,
+    },
     /// A visible tooth was given no collision shape.
     #[error("no collision shape for tooth {0}")]
     NoShape(Fdi),

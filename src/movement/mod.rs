@@ -1,8 +1,8 @@
 //! Tooth movement: loads, wire models, the quasi-static motion of each step, the next-tooth search
 //! along the arch and the collision responses (block, impulse, IPR).
 //!
-//! Engine-free core: `settings` (mobility model and response parameters), `model` (load and
-//! wire → motion, constraints), `arch_path` (sliding along the arch, next present tooth),
+//! Engine-free core: `settings` (the model choice, mobility and response parameters), `model`
+//! (the paper's load and wire → motion, constraints), [`pdl`] (the periodontal-ligament model), `arch_path` (sliding along the arch, next present tooth),
 //! [`sim`] (the whole step over a case, with the responses and their guarantees), `report` (the
 //! `simulate` command's measures) and [`MovementError`]. ECS layer (feature `ecs`):
 //! `MovementPlugin`.
@@ -10,6 +10,7 @@
 mod arch_path;
 mod error;
 mod model;
+pub mod pdl;
 #[cfg(feature = "ecs")]
 mod plugin;
 mod report;
@@ -24,8 +25,8 @@ pub use plugin::{
     SimulationState, ToothImpact,
 };
 pub use report::{
-    CaseRun, MOVED_MM, PairDistance, SimulationReport, max_penetration, neighbour_pairs,
-    pair_distances, run_case,
+    CaseRun, MOVED_MM, PairDistance, SimulationReport, ToothTravel, max_penetration,
+    neighbour_pairs, pair_distances, run_case, tooth_travel,
 };
-pub use settings::{MovementSettings, Response};
+pub use settings::{MovementModel, MovementSettings, Response};
 pub use sim::{Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome};

@@ -233,9 +233,8 @@ fn start_simulation(
             sim.method = collision.method;
         }
         if settings.is_changed() && sim.settings != *settings {
-            match settings.validate() {
-                Ok(()) => sim.settings = *settings,
-                Err(e) => error!("{e}; keeping the previous movement settings"),
+            if let Err(e) = sim.set_settings(*settings) {
+                error!("{e}; keeping the previous movement settings");
             }
         }
         return;

@@ -34,6 +34,39 @@ pub struct PairDistance {
     pub surface_gap_mm: f32,
 }
 
+/// How far one tooth went: its crown tip and root apex (points on its long axis), world frame.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ToothTravel {
+    /// FDI number.
+    pub fdi: Fdi,
+    /// Displacement of the crown tip (mm, world x, y, z).
+    pub crown_displacement_mm: [f32; 3],
+    /// Displacement of the root apex (mm, world x, y, z): opposite to the crown's when the tooth
+    /// tipped, the same when it translated.
+    pub apex_displacement_mm: [f32; 3],
+    /// Rotation from the initial pose (degrees).
+    pub rotation_deg: f32,
+}
+
+/// Crown-tip and apex travel of every tooth of a simulation.
+pub fn tooth_travel(sim: &Simulation) -> Vec<ToothTravel> {
+    sim.teeth
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let f = &t.shape.geometry.frame;
+            let tip = f.cervical_centre + f.long_axis * f.crown_length;
+            let moved = |p: glam::Vec3| (t.pose.transform_point(p) - t.initial.transform_point(p)).to_array();
+            ToothTravel {
+                fdi: t.fdi,
+                crown_displacement_mm: moved(tip),
+                apex_displacement_mm: moved(f.apex),
+                rotation_deg: sim.rotation_deg(i),
+            }
+        })
+        .collect()
+}
+
 /// The result of `orthosim simulate`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SimulationReport {
@@ -43,8 +76,12 @@ pub struct SimulationReport {
     pub algorithm: String,
     /// Collision response.
     pub response: String,
+    /// Movement model (`pdl` or `paper`).
+    pub model: String,
     /// Steps taken.
     pub steps: u64,
+    /// Clinical (PDL) or simulated (paper) time elapsed (days).
+    pub days: f64,
     /// True when the teeth came to rest before the step limit.
     pub at_rest: bool,
     /// Teeth whose crown centre moved more than 0.1 mm.
@@ -67,6 +104,8 @@ pub struct SimulationReport {
     pub impacts: usize,
     /// Kinetic energy lost in all impacts (µJ).
     pub energy_lost_uj: f64,
+    /// Crown-tip and apex travel and rotation per tooth.
+    pub teeth: Vec<ToothTravel>,
 }
 
 /// Adjacent present teeth along each arch, from the patient's right to left (indices).
@@ -191,7 +230,9 @@ pub fn run_case(
         case: name,
         algorithm: method.name().to_owned(),
         response: settings.response.name().to_owned(),
+        model: settings.model.name().to_owned(),
         steps: sim.steps,
+        days: sim.elapsed_days,
         at_rest,
         moved: sim
             .teeth
@@ -216,6 +257,7 @@ pub fn run_case(
             .collect(),
         impacts: sim.total_impacts,
         energy_lost_uj: sim.total_energy_lost_uj,
+        teeth: tooth_travel(&sim),
     };
     Ok(CaseRun {
         report,

@@ -5,7 +5,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use super::MovementError;
+use super::{MovementError, pdl::PdlSettings};
+use crate::teeth::{Arch, ToothKind, anatomy::anatomy};
 
 /// What happens when a moving tooth meets another.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -43,6 +44,40 @@ impl std::fmt::Display for Response {
     }
 }
 
+/// How a load moves a tooth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MovementModel {
+    /// The periodontal ligament: a layer of springs over the root below the alveolar crest, loads
+    /// at the bracket, contact forces solved between touching teeth, bone remodelling in
+    /// clinical time ([`crate::movement::pdl`]).
+    #[default]
+    Pdl,
+    /// The source paper's: velocity = mobility × (|load| − threshold), bodily under a rectangular
+    /// wire, tipping about a third of the root from the apex under a round one, half the load
+    /// passed to a blocking neighbour, 1/64 s steps.
+    Paper,
+}
+
+impl MovementModel {
+    /// Both models.
+    pub const ALL: [MovementModel; 2] = [MovementModel::Pdl, MovementModel::Paper];
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MovementModel::Pdl => "pdl",
+            MovementModel::Paper => "paper",
+        }
+    }
+}
+
+impl std::fmt::Display for MovementModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Parameters of tooth movement (with feature `ecs`, also the movement plugin's resource).
 ///
 /// Teeth in the periodontal ligament are overdamped: a tooth's velocity follows its net load, not
@@ -56,7 +91,11 @@ impl std::fmt::Display for Response {
 #[cfg_attr(feature = "ecs", derive(bevy::prelude::Resource))]
 #[serde(default, deny_unknown_fields)]
 pub struct MovementSettings {
-    /// Simulated seconds per step.
+    /// How loads move teeth.
+    pub model: MovementModel,
+    /// The PDL model's parameters (`model: Pdl`).
+    pub pdl: PdlSettings,
+    /// Simulated seconds per step (`model: Paper`).
     pub step_s: f32,
     /// Translational mobility (mm per second per newton above the threshold).
     pub translational_mobility: f32,
@@ -82,6 +121,8 @@ pub struct MovementSettings {
 impl Default for MovementSettings {
     fn default() -> Self {
         Self {
+            model: MovementModel::Pdl,
+            pdl: PdlSettings::default(),
             step_s: 1.0 / 64.0,
             translational_mobility: 0.5,
             rotational_mobility: 0.005,
@@ -162,7 +203,29 @@ impl MovementSettings {
             ("density_kg_per_mm3", self.density_kg_per_mm3, 1e-9, 1e-3),
             ("ipr_limit_mm", self.ipr_limit_mm, 0.0, 5.0),
         ];
-        for (field, value, min, max) in checks {
+        let shortest_root = |kinds: &[ToothKind]| {
+            kinds
+                .iter()
+                .flat_map(|&k| [Arch::Upper, Arch::Lower].map(|a| anatomy(a, k).root_length))
+                .fold(f32::INFINITY, f32::min)
+        };
+        let mut pdl = self.pdl.ranges();
+        // A crest must leave at least 2 mm of the type's shortest average root below it.
+        for (field, _, _, max) in &mut pdl {
+            let kinds: &[ToothKind] = match *field {
+                "incisor" => &[ToothKind::CentralIncisor, ToothKind::LateralIncisor],
+                "canine" => &[ToothKind::Canine],
+                "premolar" => &[ToothKind::FirstPremolar, ToothKind::SecondPremolar],
+                "molar" => &[
+                    ToothKind::FirstMolar,
+                    ToothKind::SecondMolar,
+                    ToothKind::ThirdMolar,
+                ],
+                _ => continue,
+            };
+            *max = shortest_root(kinds) - 2.0;
+        }
+        for (field, value, min, max) in checks.into_iter().chain(pdl) {
             if !value.is_finite() || value < min || value > max {
                 return Err(MovementError::Setting {
                     field,

@@ -34,6 +34,8 @@ pub struct PlacedTooth {
     pub group: Option<usize>,
     /// Wire model.
     pub wire: WireModel,
+    /// Moment-to-force ratio at the bracket from the case's loads (mm), if one is given.
+    pub mf: Option<f32>,
 }
 
 impl PlacedTooth {
@@ -127,6 +129,7 @@ impl Dentition {
                 torque: Vec3::ZERO,
                 group: None,
                 wire: case.wire_of(fdi),
+                mf: None,
             })
             .collect();
         let mut arch_forms = [arrangement.upper, ArchLayout::default().lower];
@@ -199,6 +202,9 @@ impl Dentition {
                 for t in teeth.iter_mut().filter(|t| load.teeth.0.contains(&t.fdi)) {
                     t.force += t.world_vector(&load.force);
                     t.torque += t.world_vector(&load.torque);
+                    if let Some(mf) = load.mf {
+                        t.mf = Some(mf.0);
+                    }
                 }
             }
         }

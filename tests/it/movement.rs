@@ -1,9 +1,10 @@
 //! Tooth movement: the paper's three cases reproduced headless, the three responses, determinism,
 //! rest and the ECS layer.
 //!
-//! Runs use medial trees (depth 4) built once per test process into a private tree cache, and a
-//! step four times the default (the same model, coarser in time) so that the cases run to rest in
-//! a few hundred steps.
+//! Runs use medial trees (depth 4) built once per test process into a private tree cache. The
+//! paper's cases run under both movement models: the PDL model at its default clinical step (a
+//! day), the paper's model at a step four times its default (the same model, coarser in time) so
+//! that the cases run to rest in a few hundred steps.
 
 use std::{sync::OnceLock, time::Duration};
 
@@ -13,8 +14,8 @@ use bevy::prelude::*;
 use orthosim::{
     collision::{Method, collision_shapes},
     movement::{
-        CaseRun, MovementSettings, MovementStatus, Response, Simulation, SimulationState,
-        max_penetration, run_case,
+        CaseRun, MovementModel, MovementSettings, MovementStatus, Response, Simulation,
+        SimulationState, max_penetration, run_case,
     },
     prelude::*,
     sphere_tree::{TreeCache, TreeMethod, TreeSettings},
@@ -43,19 +44,20 @@ fn cache() -> &'static TreeCache {
     })
 }
 
-fn settings(response: Response) -> MovementSettings {
+fn settings(model: MovementModel, response: Response) -> MovementSettings {
     MovementSettings {
+        model,
         step_s: 4.0 / 64.0,
         response,
         ..Default::default()
     }
 }
 
-fn run(case: &str, method: Method, response: Response) -> CaseRun {
+fn run(case: &str, method: Method, model: MovementModel, response: Response) -> CaseRun {
     run_case(
         case,
         method,
-        settings(response),
+        settings(model, response),
         medial(),
         Some(cache()),
         10_000,
@@ -77,26 +79,44 @@ fn gap(run: &CaseRun, a: u8, b: u8) -> f32 {
         .surface_gap_mm
 }
 
+/// Both movement models under the three sphere-tree methods.
+fn models_and_methods() -> Vec<(MovementModel, Method)> {
+    MovementModel::ALL
+        .into_iter()
+        .flat_map(|m| {
+            [Method::Spheres, Method::Continuous, Method::Exact].map(move |method| (m, method))
+        })
+        .collect()
+}
+
 /// The paper's outcome for a case: who moves, who stays, at rest, no penetration beyond the
 /// method's tolerance.
-fn check_case(case: &str, method: Method, moves: &[u8], stays: &[u8]) -> CaseRun {
-    let r = run(case, method, Response::Block);
+fn check_case(
+    case: &str,
+    method: Method,
+    model: MovementModel,
+    moves: &[u8],
+    stays: &[u8],
+) -> CaseRun {
+    let r = run(case, method, model, Response::Block);
     let rep = &r.report;
     assert!(
         rep.at_rest,
-        "{case} {method:?}: not at rest after {} steps",
+        "{case} {method:?} {model}: not at rest after {} steps",
         rep.steps
     );
     for f in fdis(moves) {
         assert!(
             rep.moved.contains(&f),
-            "{case} {method:?}: {f} should move: {rep:?}"
+            "{case} {method:?} {model}: {f} should move: {:?}",
+            rep.displacement_mm
         );
     }
     for f in fdis(stays) {
         assert!(
             !rep.moved.contains(&f),
-            "{case} {method:?}: {f} should stay: {rep:?}"
+            "{case} {method:?} {model}: {f} should stay: {:?}",
+            rep.displacement_mm
         );
     }
     let tolerance = match method {
@@ -105,7 +125,7 @@ fn check_case(case: &str, method: Method, moves: &[u8], stays: &[u8]) -> CaseRun
     };
     assert!(
         rep.max_penetration_mm <= tolerance,
-        "{case} {method:?}: penetration {}",
+        "{case} {method:?} {model}: penetration {}",
         rep.max_penetration_mm
     );
     r
@@ -113,10 +133,11 @@ fn check_case(case: &str, method: Method, moves: &[u8], stays: &[u8]) -> CaseRun
 
 #[test]
 fn case1_moves_first_molars_and_second_premolars_not_incisors() {
-    for method in [Method::Spheres, Method::Continuous, Method::Exact] {
+    for (model, method) in models_and_methods() {
         let r = check_case(
             "case1",
             method,
+            model,
             &[16, 26, 36, 46, 15, 25, 35, 45],
             &[11, 12, 21, 22, 31, 32, 41, 42],
         );
@@ -124,7 +145,7 @@ fn case1_moves_first_molars_and_second_premolars_not_incisors() {
         let limit = if method == Method::Exact { 0.011 } else { 0.5 };
         for (a, b) in [(15, 13), (23, 25), (45, 43), (33, 35)] {
             let g = gap(&r, a, b);
-            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+            assert!(g <= limit, "{method:?} {model}: {a}-{b} gap {g}");
         }
         // Constrained to translate along the arch: no vertical travel.
         for t in &r.simulation.teeth {
@@ -145,7 +166,10 @@ fn spheres_move_the_first_molars_at_the_default_step() {
     let r = run_case(
         "case1",
         Method::Spheres,
-        MovementSettings::default(),
+        MovementSettings {
+            model: MovementModel::Paper,
+            ..Default::default()
+        },
         medial(),
         Some(cache()),
         10_000,
@@ -166,32 +190,30 @@ fn spheres_move_the_first_molars_at_the_default_step() {
 
 #[test]
 fn case2_moves_first_molars_and_first_premolars_not_canines() {
-    for method in [Method::Spheres, Method::Continuous, Method::Exact] {
+    for (model, method) in models_and_methods() {
         let r = check_case(
             "case2",
             method,
+            model,
             &[16, 26, 36, 46, 14, 24, 34, 44],
             &[13, 23, 33, 43, 12, 22, 32, 42],
         );
         let limit = if method == Method::Exact { 0.011 } else { 0.5 };
         for (a, b) in [(16, 14), (24, 26), (46, 44), (34, 36)] {
             let g = gap(&r, a, b);
-            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+            assert!(g <= limit, "{method:?} {model}: {a}-{b} gap {g}");
         }
     }
 }
 
 #[test]
 fn case3_closes_the_diastemas() {
-    for (method, limit) in [
-        (Method::Exact, 0.011),
-        (Method::Continuous, 0.15),
-        (Method::Spheres, 0.15),
-    ] {
-        let r = check_case("case3", method, &[11, 21, 31, 41], &[13, 23, 33, 43]);
+    for (model, method) in models_and_methods() {
+        let limit = if method == Method::Exact { 0.011 } else { 0.15 };
+        let r = check_case("case3", method, model, &[11, 21, 31, 41], &[13, 23, 33, 43]);
         for (a, b) in [(11, 21), (41, 31)] {
             let g = gap(&r, a, b);
-            assert!(g <= limit, "{method:?}: {a}-{b} gap {g}");
+            assert!(g <= limit, "{method:?} {model}: {a}-{b} gap {g}");
         }
     }
 }
@@ -199,9 +221,10 @@ fn case3_closes_the_diastemas() {
 #[test]
 fn circles_leave_larger_distances_than_sphere_trees() {
     for case in ["case1", "case2"] {
-        let circles = run(case, Method::Circles, Response::Block).report;
-        let spheres = run(case, Method::Spheres, Response::Block).report;
-        let continuous = run(case, Method::Continuous, Response::Block).report;
+        let paper = MovementModel::Paper;
+        let circles = run(case, Method::Circles, paper, Response::Block).report;
+        let spheres = run(case, Method::Spheres, paper, Response::Block).report;
+        let continuous = run(case, Method::Continuous, paper, Response::Block).report;
         assert!(
             circles.total_centre_distance_mm > spheres.total_centre_distance_mm,
             "{case}: circles {} spheres {}",
@@ -233,8 +256,9 @@ fn circles_leave_larger_distances_than_sphere_trees() {
     }
     // Case 3: the circles of the proclined upper incisors (crown and root) overlap across the
     // diastema, so circles cannot close it at all; the sphere trees can.
-    let circles = run("case3", Method::Circles, Response::Block);
-    let spheres = run("case3", Method::Spheres, Response::Block);
+    let paper = MovementModel::Paper;
+    let circles = run("case3", Method::Circles, paper, Response::Block);
+    let spheres = run("case3", Method::Spheres, paper, Response::Block);
     assert!(gap(&circles, 11, 21) > 2.0);
     assert!(gap(&spheres, 11, 21) < 0.2);
 }
@@ -243,51 +267,56 @@ fn circles_leave_larger_distances_than_sphere_trees() {
 fn the_same_run_gives_bit_identical_poses() {
     let d = Dentition::build(Case::resolve("case1").unwrap()).unwrap();
     let shapes = collision_shapes(&d, medial(), Some(cache())).unwrap();
-    let poses = || {
-        let mut sim = Simulation::new(
-            &d,
-            shapes.clone(),
-            Method::Continuous,
-            settings(Response::Block),
-        )
-        .unwrap();
-        for _ in 0..150 {
-            sim.step();
-        }
-        sim.teeth.iter().map(|t| t.pose).collect::<Vec<_>>()
-    };
-    let (a, b) = (poses(), poses());
-    assert!(a.iter().zip(&b).all(|(x, y)| x == y));
-    assert!(a.iter().any(|p| p.is_finite()));
+    for model in MovementModel::ALL {
+        let poses = || {
+            let mut sim = Simulation::new(
+                &d,
+                shapes.clone(),
+                Method::Continuous,
+                settings(model, Response::Block),
+            )
+            .unwrap();
+            for _ in 0..150 {
+                sim.step();
+            }
+            sim.teeth.iter().map(|t| t.pose).collect::<Vec<_>>()
+        };
+        let (a, b) = (poses(), poses());
+        assert!(a.iter().zip(&b).all(|(x, y)| x == y), "{model}");
+        assert!(a.iter().all(|p| p.is_finite()), "{model}");
+        assert!(a != d.visible().map(|t| t.pose).collect::<Vec<_>>(), "{model}: nothing moved");
+    }
 }
 
 #[test]
 fn resting_teeth_do_not_move_or_drift() {
-    // No loads: at rest at once, poses untouched.
-    let normal = run("normal", Method::Exact, Response::Block);
-    assert!(normal.report.at_rest && normal.report.steps <= 2);
-    assert!(normal.report.moved.is_empty());
-    for t in &normal.simulation.teeth {
-        assert_eq!(t.pose, t.initial, "{}", t.fdi);
+    for model in MovementModel::ALL {
+        // No loads: at rest at once, poses untouched.
+        let normal = run("normal", Method::Exact, model, Response::Block);
+        assert!(normal.report.at_rest && normal.report.steps <= 2, "{model}");
+        assert!(normal.report.moved.is_empty());
+        for t in &normal.simulation.teeth {
+            assert_eq!(t.pose, t.initial, "{model} {}", t.fdi);
+        }
+        // A case at rest stays there, with no growth of penetration.
+        let mut r = run("case3", Method::Exact, model, Response::Block);
+        let rest: Vec<_> = r.simulation.teeth.iter().map(|t| t.pose).collect();
+        let before = max_penetration(&r.simulation);
+        for _ in 0..500 {
+            r.simulation.step();
+        }
+        for (t, p) in r.simulation.teeth.iter().zip(&rest) {
+            assert_eq!(t.pose, *p, "{model}: {} drifted", t.fdi);
+        }
+        assert!(max_penetration(&r.simulation) <= before + 1e-6, "{model}");
     }
-    // A case at rest stays there, with no growth of penetration.
-    let mut r = run("case3", Method::Exact, Response::Block);
-    let rest: Vec<_> = r.simulation.teeth.iter().map(|t| t.pose).collect();
-    let before = max_penetration(&r.simulation);
-    for _ in 0..500 {
-        r.simulation.step();
-    }
-    for (t, p) in r.simulation.teeth.iter().zip(&rest) {
-        assert_eq!(t.pose, *p, "{} drifted", t.fdi);
-    }
-    assert!(max_penetration(&r.simulation) <= before + 1e-6);
 }
 
 #[test]
 fn impulse_conserves_momentum_and_never_gains_energy() {
     let d = Dentition::build(Case::resolve("case3").unwrap()).unwrap();
     let shapes = collision_shapes(&d, medial(), Some(cache())).unwrap();
-    let settings = settings(Response::Impulse);
+    let settings = settings(MovementModel::Paper, Response::Impulse);
     let mut sim = Simulation::new(&d, shapes, Method::Exact, settings).unwrap();
     let mut impacts = Vec::new();
     for _ in 0..2000 {
@@ -320,8 +349,8 @@ fn impulse_conserves_momentum_and_never_gains_energy() {
 
 #[test]
 fn ipr_records_the_overlap_within_its_limit() {
-    let r = run("case3", Method::Continuous, Response::Ipr);
-    let limit = settings(Response::Ipr).ipr_limit_mm;
+    let r = run("case3", Method::Continuous, MovementModel::Paper, Response::Ipr);
+    let limit = settings(MovementModel::Paper, Response::Ipr).ipr_limit_mm;
     let upper = r.report.ipr_mm.get("11-21").copied().unwrap_or(0.0);
     let lower = r.report.ipr_mm.get("41-31").copied().unwrap_or(0.0);
     assert!(upper > 0.05 && lower > 0.05, "{:?}", r.report.ipr_mm);
@@ -559,7 +588,7 @@ fn teeth_are_extracted_and_restored_while_the_case_runs() {
         &d,
         shapes.clone(),
         Method::Continuous,
-        settings(Response::Block),
+        settings(MovementModel::Pdl, Response::Block),
     )
     .unwrap();
     let fdi = |n: u8| Fdi::new(n as i64).unwrap();

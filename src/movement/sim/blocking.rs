@@ -95,7 +95,10 @@ impl Simulation {
         found.sort_by_key(|f| (f.a, f.b));
         self.last = StepOutcome::default();
         match self.settings.response {
-            Response::Block => self.block(found, true),
+            Response::Block => {
+                let pass = self.settings.model == crate::movement::MovementModel::Paper;
+                self.block(found, pass)
+            }
             Response::Impulse => {
                 let changed = self.impulse(&found);
                 let found = self.retest(found, &changed);
@@ -151,6 +154,11 @@ impl Simulation {
                 break;
             }
             let hard = round >= SOFT_ROUNDS;
+            for &(k, _) in &stops {
+                let f = &found[k];
+                self.last.blocking.retain(|b| (b.a, b.b) != (f.a, f.b));
+                self.last.blocking.push(f.clone());
+            }
             let mut stop = vec![1.0f32; n];
             for &(k, t) in &stops {
                 let f = &found[k];

@@ -10,7 +10,10 @@ use crate::{
     collision::{Circle, CollisionShape, Method, Motion},
     geometry::mesh_separation,
     movement::{
-        MovementError, arch_path::arc_of, model::ToothConstraint, settings::MovementSettings,
+        MovementError,
+        arch_path::arc_of,
+        model::ToothConstraint,
+        settings::{MovementModel, MovementSettings},
     },
     teeth::{Dentition, Fdi, Load, WireModel, arch::ArchCurve, case::Freedoms},
 };
@@ -101,6 +104,8 @@ impl Simulation {
                 initial: t.pose,
                 pose: t.pose,
                 arc: arc_of(curve, &t.pose),
+                mf: t.mf,
+                pdl: None,
             });
         }
         let groups = d
@@ -120,7 +125,7 @@ impl Simulation {
             })
             .collect();
         let n = teeth.len();
-        Ok(Self {
+        let mut sim = Self {
             motions: teeth.iter().map(|t| Motion::still(t.pose)).collect(),
             teeth,
             groups,
@@ -137,7 +142,63 @@ impl Simulation {
             still_steps: 0,
             total_impacts: 0,
             total_energy_lost_uj: 0.0,
-        })
+            pdl: super::PdlState::default(),
+            elapsed_days: 0.0,
+        };
+        if settings.model == MovementModel::Pdl {
+            sim.prepare_pdl()?;
+        }
+        Ok(sim)
+    }
+
+    /// Replaces the movement settings (for the UI), computing the teeth's ligaments when the PDL
+    /// model or its parameters change; refuses, keeping the old settings, settings out of range
+    /// or a tooth that cannot carry a ligament.
+    ///
+    /// # Errors
+    /// [`MovementError::Setting`] or [`MovementError::Pdl`].
+    pub fn set_settings(&mut self, settings: MovementSettings) -> Result<(), MovementError> {
+        settings.validate()?;
+        let old = self.settings;
+        if settings.pdl != old.pdl {
+            for t in &mut self.teeth {
+                t.pdl = None;
+            }
+        }
+        self.settings = settings;
+        if settings.model == MovementModel::Pdl
+            && let Err(e) = self.prepare_pdl()
+        {
+            self.settings = old;
+            for t in &mut self.teeth {
+                t.pdl = None;
+            }
+            if old.model == MovementModel::Pdl {
+                self.prepare_pdl()?;
+            }
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    /// Sets a tooth's moment-to-force ratio at the bracket (mm; None: the wire decides).
+    ///
+    /// # Errors
+    /// [`MovementError::Setting`] for a ratio that is not finite or beyond ±30 mm.
+    pub fn set_mf(&mut self, i: usize, mf: Option<f32>) -> Result<(), MovementError> {
+        let max = crate::teeth::case::MAX_MF_MM;
+        if let Some(v) = mf
+            && !(v.is_finite() && v.abs() <= max)
+        {
+            return Err(MovementError::Setting {
+                field: "mf",
+                value: v,
+                min: -max,
+                max,
+            });
+        }
+        self.teeth[i].mf = mf;
+        Ok(())
     }
 
     /// Replaces a tooth's own load (for the UI and messages); refuses, keeping the old one, a load
@@ -241,6 +302,7 @@ impl Simulation {
                 t.initial = old.initial;
                 t.load = old.load;
                 t.wire = old.wire;
+                t.mf = old.mf;
             }
         }
         for (g, old) in next.groups.iter_mut().zip(&self.groups) {
@@ -250,6 +312,7 @@ impl Simulation {
         next.ipr = self.ipr.clone();
         next.total_impacts = self.total_impacts;
         next.total_energy_lost_uj = self.total_energy_lost_uj;
+        next.elapsed_days = self.elapsed_days;
         Ok(next)
     }
 }

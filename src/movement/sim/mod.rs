@@ -58,12 +58,16 @@ use serde::Serialize;
 mod blocking;
 mod editing;
 mod impulse;
+mod pdl_step;
 mod proposal;
+
+pub use pdl_step::{MAX_SWEEPS, PUSH_BIAS_MM, PdlState, SOLVE_TOLERANCE_MM};
 
 use super::{
     arch_path::{ArchFrame, arc_of, frame_at},
     model::{Centres, ToothConstraint},
-    settings::{MovementSettings, Response},
+    pdl::PdlStiffness,
+    settings::{MovementModel, MovementSettings, Response},
 };
 use crate::{
     collision::broad_phase::{BroadItem, candidate_pairs},
@@ -106,6 +110,11 @@ pub struct SimTooth {
     pub pose: Pose,
     /// Arc length of its local origin on its arch curve.
     pub arc: f32,
+    /// Moment-to-force ratio at the bracket (mm) under a rectangular wire (PDL model); None: the
+    /// wire's engagement decides.
+    pub mf: Option<f32>,
+    /// The tooth's ligament (PDL model), shared between teeth of one shape.
+    pub pdl: Option<std::sync::Arc<PdlStiffness>>,
 }
 
 impl SimTooth {
@@ -191,6 +200,8 @@ pub struct StepOutcome {
     pub collision_ns: u64,
     /// Contacts as the step ended (for the last motions tested of each pair).
     pub contacts: Vec<Found>,
+    /// Contacts that stopped a tooth in this step, as found when they stopped it.
+    pub blocking: Vec<Found>,
     /// Impacts (`impulse`).
     pub impacts: Vec<Impact>,
 }
@@ -230,6 +241,10 @@ pub struct Simulation {
     pub total_impacts: usize,
     /// Kinetic energy lost in all impacts (µJ).
     pub total_energy_lost_uj: f64,
+    /// The PDL model's contacts, forces and twists between steps.
+    pub pdl: PdlState,
+    /// Clinical (PDL) or simulated (paper) time elapsed (days).
+    pub elapsed_days: f64,
 }
 
 fn row(arch: Arch) -> usize {
@@ -370,6 +385,19 @@ impl Simulation {
             .sum::<f64>();
         self.last.moved = moved;
         self.still_steps = if moved == 0 { self.still_steps + 1 } else { 0 };
+        self.elapsed_days += match self.settings.model {
+            MovementModel::Pdl => self.settings.pdl.step_days(),
+            MovementModel::Paper => self.settings.step_s as f64 / 86_400.0,
+        };
+        if self.settings.model == MovementModel::Pdl {
+            let before: Vec<(usize, usize)> = self.pdl.touching.iter().map(|f| (f.a, f.b)).collect();
+            self.carry_contacts();
+            let after: Vec<(usize, usize)> = self.pdl.touching.iter().map(|f| (f.a, f.b)).collect();
+            // Nothing moved and the contacts are the same: the next solve is this one again.
+            self.last.at_rest = moved == 0 && (before == after || self.still_steps >= 2);
+            self.steps += 1;
+            return;
+        }
         // Standing still with the same passed loads changes nothing in later steps; loads passed
         // back and forth between blocked teeth may cycle, which settles within a pass along a
         // whole arch.

@@ -4,6 +4,7 @@
 use glam::Vec3;
 
 use super::Simulation;
+use crate::movement::settings::MovementModel;
 use crate::{
     collision::Motion,
     geometry::Pose,
@@ -82,6 +83,10 @@ impl Simulation {
         self.passed = std::mem::replace(&mut self.next_passed, vec![Vec3::ZERO; n]);
         self.motions = self.teeth.iter().map(|t| Motion::still(t.pose)).collect();
         self.ipr_over.clear();
+        if self.settings.model == MovementModel::Pdl {
+            self.propose_pdl();
+            return;
+        }
         for i in 0..n {
             if self.teeth[i].group.is_some() {
                 continue;

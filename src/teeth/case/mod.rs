@@ -32,6 +32,8 @@ pub const MAX_NAME_CHARS: usize = 120;
 
 /// Largest force accepted on one load (N); orthodontic forces are 0.1–5 N.
 pub const MAX_FORCE_N: f32 = 50.0;
+/// Largest moment-to-force ratio a load may ask for (mm): past the root's length.
+pub const MAX_MF_MM: f32 = 30.0;
 /// Largest torque accepted on one load (N·mm); orthodontic moments are up to about 30 N·mm.
 pub const MAX_TORQUE_NMM: f32 = 500.0;
 
@@ -440,6 +442,18 @@ impl Case {
                     "torque",
                     None,
                     format!("torque of {tm:.1} N·mm is beyond the {MAX_TORQUE_NMM} N·mm accepted"),
+                ));
+            }
+            if let Some(mf) = load.mf
+                && mf.0.abs() > MAX_MF_MM
+            {
+                return Err((
+                    "mf",
+                    None,
+                    format!(
+                        "a moment-to-force ratio of {} mm is beyond the ±{MAX_MF_MM} mm accepted",
+                        mf.0
+                    ),
                 ));
             }
         }

@@ -61,6 +61,11 @@ pub struct CaseLoad {
     /// True: the teeth move as one block (a segment on a wire); false: each tooth gets the load.
     #[serde(default)]
     pub as_group: bool,
+    /// Moment-to-force ratio at the bracket (mm): the bracket adds a couple of M/F × the force
+    /// across the long axis, against the force's tipping (PDL model, rectangular wire; none:
+    /// the wire's engagement decides).
+    #[serde(default)]
+    pub mf: Option<Finite>,
 }
 
 /// Archwire cross-section, which decides how a tooth responds to a load (paper, section 3).

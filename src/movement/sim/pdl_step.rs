@@ -1,0 +1,371 @@
+//! The PDL model's loads and motion for a step: each tooth (or group) as a body on its ligament,
+//! the contact forces of the touching teeth solved together, and the twist of each body in the
+//! step's clinical time, applied as a rigid motion about its centre of resistance.
+//!
+//! Contacts are those the last step's narrow phase reported (where the teeth touched as the step
+//! ended), and earlier ones between teeth that have not moved since. The solve asks touching teeth
+//! that move together to open by [`PUSH_BIAS_MM`] per step, so that rounding never makes the
+//! pushed tooth trail its pusher; teeth at rest are never pushed apart.
+
+use std::sync::Arc;
+
+use glam::{DMat3, DVec3, Vec3};
+
+use super::{Found, Simulation};
+use crate::{
+    collision::Motion,
+    geometry::{Pose, Vec6, halves, vec6},
+    movement::{
+        MovementError,
+        model::{Drive, angle_between},
+        pdl::{
+            ContactRow, PdlBody, PdlStiffness, SolveParams, blocked, centre_of_elasticity,
+            constrained_compliance, engaged, rotated, shifted, solve_contacts, wrench,
+        },
+    },
+    teeth::WireModel,
+};
+
+/// Opening speed asked of touching teeth that move together (mm per step).
+pub const PUSH_BIAS_MM: f64 = 1e-5;
+/// Convergence tolerance of the contact solve (mm per step).
+pub const SOLVE_TOLERANCE_MM: f64 = 1e-9;
+/// Most sweeps of the contact solve.
+pub const MAX_SWEEPS: usize = 200;
+
+/// The PDL state of a simulation between steps.
+#[derive(Clone, Debug, Default)]
+pub struct PdlState {
+    /// Contacts carried into the next step's solve (touching as the last step ended).
+    pub touching: Vec<Found>,
+    /// The forces of the last solve, one per touching contact (N).
+    pub forces: Vec<f64>,
+    /// Each tooth's twist in the last step (world, about its centre of resistance; mm, rad).
+    pub twists: Vec<Vec6>,
+    /// Each tooth's net wrench in the last step (world, about its centre of resistance).
+    pub wrenches: Vec<Vec6>,
+    /// Sweeps of the last contact solve.
+    pub sweeps: usize,
+}
+
+/// One body of the step: its members and its ligament.
+struct Unit {
+    members: Vec<usize>,
+    body: PdlBody,
+}
+
+impl Simulation {
+    /// Computes the ligament of every tooth that has none (once per distinct shape).
+    ///
+    /// # Errors
+    /// [`MovementError::Pdl`] naming the tooth whose root cannot carry a ligament.
+    pub(crate) fn prepare_pdl(&mut self) -> Result<(), MovementError> {
+        let mut made: Vec<(*const crate::teeth::ToothGeometry, Arc<PdlStiffness>)> = Vec::new();
+        for t in &mut self.teeth {
+            if t.pdl.is_some() {
+                continue;
+            }
+            let g = &t.shape.geometry;
+            let key = Arc::as_ptr(g);
+            if let Some((_, p)) = made.iter().find(|(k, _)| *k == key) {
+                t.pdl = Some(p.clone());
+                continue;
+            }
+            let p = Arc::new(PdlStiffness::of(g, &self.settings.pdl).map_err(|source| {
+                MovementError::Pdl {
+                    fdi: t.fdi,
+                    source,
+                }
+            })?);
+            made.push((key, p.clone()));
+            t.pdl = Some(p);
+        }
+        Ok(())
+    }
+
+    /// World centre of resistance of tooth `i` at its current pose.
+    pub fn centre_of_resistance(&self, i: usize) -> Option<Vec3> {
+        let t = &self.teeth[i];
+        Some(t.pose.transform_point(t.pdl.as_ref()?.centre_of_resistance))
+    }
+
+    /// World bracket point of tooth `i` at its current pose.
+    pub fn bracket(&self, i: usize) -> Option<Vec3> {
+        let t = &self.teeth[i];
+        Some(t.pose.transform_point(t.pdl.as_ref()?.bracket))
+    }
+
+    /// The current centre of rotation of tooth `i` (world): the point of its last step's screw
+    /// axis nearest its centre of resistance; None when it did not turn (or translated).
+    pub fn centre_of_rotation(&self, i: usize) -> Option<Vec3> {
+        let t = self.pdl.twists.get(i)?;
+        let c = self.centre_of_resistance(i)?.as_dvec3();
+        let (u, theta) = halves(t);
+        let tt = theta.length_squared();
+        // A turn that moves the tooth less than its translation over 100 mm counts as none.
+        if tt <= 0.0 || theta.length() * 100.0 < u.length() {
+            return None;
+        }
+        Some((c + theta.cross(u) / tt).as_vec3())
+    }
+
+    /// The orthonormal twists tooth `i` may make (constraints: arch-frame translations, rotations
+    /// about its anatomical axes).
+    fn allowed_twists(&self, i: usize) -> Vec<Vec6> {
+        let t = &self.teeth[i];
+        let c = &t.constraint;
+        let frame = self.arch_frame(i);
+        let anatomical = [
+            t.pose
+                .transform_vector(Vec3::X * t.fdi.local_x_mesial_sign()),
+            t.pose.transform_vector(Vec3::Z),
+            t.pose.transform_vector(Vec3::Y),
+        ];
+        let flags = |f: crate::teeth::case::Freedoms| [f.mesial, f.buccal, f.occlusal];
+        let mut out = Vec::new();
+        for (axis, on) in [frame.tangent, frame.buccal, frame.up]
+            .into_iter()
+            .zip(flags(c.translate))
+        {
+            if on {
+                out.push(vec6(axis.as_dvec3().normalize(), DVec3::ZERO));
+            }
+        }
+        for (axis, on) in anatomical.into_iter().zip(flags(c.rotate)) {
+            if on {
+                out.push(vec6(DVec3::ZERO, axis.as_dvec3().normalize()));
+            }
+        }
+        out
+    }
+
+    /// The body of `members` (one tooth, or a group led by the first) under `force` at the
+    /// bracket(s) and `torque`.
+    fn unit(&self, members: Vec<usize>, force: Vec3, torque: Vec3) -> Option<Unit> {
+        let lead = members[0];
+        let s = &self.settings.pdl;
+        let mut parts = Vec::new();
+        for &i in &members {
+            let t = &self.teeth[i];
+            let p = t.pdl.as_ref()?;
+            let r = DMat3::from_quat(t.pose.rotation.as_dquat());
+            let c = t.pose.transform_point(p.centre_of_resistance).as_dvec3();
+            parts.push((rotated(&p.stiffness, r), c, p));
+        }
+        let n = parts.len() as f64;
+        let mean = parts.iter().map(|(_, c, _)| *c).sum::<DVec3>() / n;
+        let sum = parts
+            .iter()
+            .fold(crate::geometry::Mat6::ZERO, |acc, (k, c, _)| {
+                acc.add_scaled(&shifted(k, *c, mean), 1.0)
+            });
+        let centre = if members.len() == 1 {
+            parts[0].1
+        } else {
+            centre_of_elasticity(&sum, mean)?
+        };
+        let k = shifted(&sum, mean, centre);
+        let mut compliance = constrained_compliance(&k, &self.allowed_twists(lead))?;
+        let t = &self.teeth[lead];
+        let bracket = members
+            .iter()
+            .filter_map(|&i| self.bracket(i))
+            .sum::<Vec3>()
+            / n as f32;
+        let axis = t.pose.transform_vector(t.shape.geometry.frame.long_axis);
+        if s.wire_holds_brackets {
+            let frame = self.arch_frame(lead);
+            let b = bracket.as_dvec3() - centre;
+            let across: Vec<Vec6> = [frame.buccal, frame.up]
+                .into_iter()
+                .map(|n| {
+                    let n = n.as_dvec3();
+                    vec6(n, b.cross(n))
+                })
+                .collect();
+            compliance = blocked(&compliance, &across, 1.0);
+        }
+        let mut couple = torque.as_dvec3();
+        match (t.wire, t.mf) {
+            (WireModel::Rectangular, Some(mf)) => {
+                couple -= (axis.cross(force) * mf).as_dvec3();
+            }
+            (WireModel::Rectangular, None) => {
+                compliance = engaged(&compliance, s.wire_engagement as f64);
+            }
+            (WireModel::Round, _) => {}
+        }
+        let applied = wrench(force.as_dvec3(), bracket.as_dvec3(), couple, centre);
+        let area = parts.iter().map(|(_, _, p)| p.root_area_mm2).sum();
+        Some(Unit {
+            members,
+            body: PdlBody {
+                centre,
+                compliance,
+                area,
+                mean_spring: parts[0].2.mean_spring,
+                applied,
+            },
+        })
+    }
+
+    /// Loads and motion under the PDL model (see the module doc).
+    pub(super) fn propose_pdl(&mut self) {
+        let n = self.teeth.len();
+        let mut units = Vec::new();
+        for i in 0..n {
+            if self.teeth[i].group.is_none() {
+                let l = self.teeth[i].load;
+                units.extend(self.unit(vec![i], l.force, l.torque));
+            }
+        }
+        for g in &self.groups {
+            if !g.members.is_empty() {
+                units.extend(self.unit(g.members.clone(), g.load.force, g.load.torque));
+            }
+        }
+        let mut body_of = vec![usize::MAX; n];
+        for (u, unit) in units.iter().enumerate() {
+            for &i in &unit.members {
+                body_of[i] = u;
+            }
+        }
+        let mut rows = Vec::new();
+        let mut row_of = Vec::new();
+        for (k, f) in self.pdl.touching.iter().enumerate() {
+            let (a, b) = (body_of[f.a], body_of[f.b]);
+            let normal = f.contact.normal.as_dvec3();
+            if a == usize::MAX || b == usize::MAX || a == b || normal.length_squared() < 0.5 {
+                continue;
+            }
+            rows.push(ContactRow {
+                a,
+                b,
+                point: ((f.contact.points[0] + f.contact.points[1]) * 0.5).as_dvec3(),
+                normal: normal.normalize(),
+                bias: 0.0,
+            });
+            row_of.push(k);
+        }
+        let bodies: Vec<PdlBody> = units.iter().map(|u| u.body.clone()).collect();
+        let s = &self.settings.pdl;
+        let params = SolveParams {
+            rate: s.remodelling_per_day as f64 * s.step_days(),
+            threshold_kpa: s.threshold_kpa as f64,
+            tolerance: SOLVE_TOLERANCE_MM,
+            max_sweeps: MAX_SWEEPS,
+        };
+        let warm: Vec<f64> = row_of
+            .iter()
+            .map(|&k| self.pdl.forces.get(k).copied().unwrap_or(0.0))
+            .collect();
+        let mut solve = solve_contacts(&bodies, &rows, Some(&warm), &params);
+        // Touching teeth that move together open by the bias (see the module doc).
+        let moving = |t: &Vec6| t.iter().any(|v| *v != 0.0);
+        let pushing: Vec<bool> = rows
+            .iter()
+            .zip(&solve.forces)
+            .map(|(r, f)| *f > 0.0 && (moving(&solve.twists[r.a]) || moving(&solve.twists[r.b])))
+            .collect();
+        if pushing.iter().any(|&p| p) {
+            for (r, p) in rows.iter_mut().zip(&pushing) {
+                if *p {
+                    r.bias = PUSH_BIAS_MM;
+                }
+            }
+            solve = solve_contacts(&bodies, &rows, Some(&solve.forces), &params);
+        }
+        self.pdl.sweeps = solve.sweeps;
+        let mut forces = vec![0.0; self.pdl.touching.len()];
+        for (r, &k) in row_of.iter().enumerate() {
+            forces[k] = solve.forces[r];
+        }
+        self.pdl.forces = forces;
+        self.pdl.twists = vec![[0.0; 6]; n];
+        self.pdl.wrenches = vec![[0.0; 6]; n];
+        for (u, unit) in units.iter().enumerate() {
+            for &i in &unit.members {
+                self.pdl.twists[i] = solve.twists[u];
+                self.pdl.wrenches[i] = solve.wrenches[u];
+                self.effective[i] = halves(&solve.wrenches[u]).0.as_vec3();
+            }
+        }
+        for (u, unit) in units.iter().enumerate() {
+            let (v, w) = halves(&solve.twists[u]);
+            let d = Drive {
+                velocity: v.as_vec3(),
+                angular: w.as_vec3(),
+                pivot: unit.body.centre.as_vec3(),
+            };
+            if !d.is_zero() {
+                self.move_rigid(&unit.members, d);
+            }
+        }
+    }
+
+    /// Moves `members` rigidly by the per-step twist `d` about its pivot, as far as the limits of
+    /// all of them allow.
+    fn move_rigid(&mut self, members: &[usize], d: Drive) {
+        let end = |pose: &Pose, f: f32| {
+            let turn = glam::Quat::from_scaled_axis(d.angular * f);
+            Pose::new(
+                (turn * pose.rotation).normalize(),
+                d.pivot + d.velocity * f + turn * (pose.translation - d.pivot),
+            )
+        };
+        let f = crate::movement::model::largest_fraction(|f| {
+            members
+                .iter()
+                .all(|&i| self.within_limits(i, &end(&self.teeth[i].pose, f)))
+        });
+        if f <= 1e-6 {
+            return;
+        }
+        for &i in members {
+            let to = end(&self.teeth[i].pose, f);
+            if to.is_finite() {
+                self.motions[i] = Motion {
+                    start: self.teeth[i].pose,
+                    end: to,
+                };
+            }
+        }
+    }
+
+    /// Carries contacts into the next step: those found in this step (at its end, or where they
+    /// stopped a tooth), and earlier ones between teeth that did not move.
+    pub(super) fn carry_contacts(&mut self) {
+        let mut next: Vec<Found> = self.last.contacts.clone();
+        for b in &self.last.blocking {
+            if !next.iter().any(|f| (f.a, f.b) == (b.a, b.b)) {
+                next.push(b.clone());
+            }
+        }
+        next.sort_by_key(|f| (f.a, f.b));
+        let mut forces: Vec<f64> = next
+            .iter()
+            .map(|f| {
+                self.pdl
+                    .touching
+                    .iter()
+                    .position(|o| (o.a, o.b) == (f.a, f.b))
+                    .map_or(0.0, |k| self.pdl.forces.get(k).copied().unwrap_or(0.0))
+            })
+            .collect();
+        for (k, old) in self.pdl.touching.iter().enumerate() {
+            let still = self.motions[old.a].is_still() && self.motions[old.b].is_still();
+            if still && !next.iter().any(|f| (f.a, f.b) == (old.a, old.b)) {
+                next.push(old.clone());
+                forces.push(self.pdl.forces.get(k).copied().unwrap_or(0.0));
+            }
+        }
+        self.pdl.touching = next;
+        self.pdl.forces = forces;
+    }
+
+    /// Rotation of tooth `i` from its initial pose (degrees).
+    pub fn rotation_deg(&self, i: usize) -> f32 {
+        let t = &self.teeth[i];
+        angle_between(t.pose.rotation, t.initial.rotation).to_degrees()
+    }
+}
