@@ -21,7 +21,8 @@ pub use error::MovementError;
 pub use model::ToothConstraint;
 #[cfg(feature = "ecs")]
 pub use plugin::{
-    MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad, SetLoad, SetWire,
+    MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad, SetLoad,
+    SetMomentToForce, SetWire,
     SimulationState, ToothImpact,
 };
 pub use report::{

@@ -83,6 +83,8 @@ pub struct MovementStatus {
     pub moved: usize,
     /// Nothing moves any more.
     pub at_rest: bool,
+    /// Clinical (PDL) or simulated (paper) time elapsed (days).
+    pub days: f64,
     /// Time of the last step's broad phase, narrow phase and response (µs).
     pub collision_us: f64,
 }
@@ -116,6 +118,16 @@ pub struct SetWire {
     pub tooth: Entity,
     /// Its wire model from now on.
     pub wire: WireModel,
+}
+
+/// Set a tooth's moment-to-force ratio at the bracket (mm; None: the wire's engagement decides),
+/// PDL model. A ratio out of range is refused with a notice in [`SimulationState::notice`].
+#[derive(Message, Clone, Copy, Debug, PartialEq)]
+pub struct SetMomentToForce {
+    /// The tooth.
+    pub tooth: Entity,
+    /// Its M/F from now on.
+    pub mf: Option<f32>,
 }
 
 /// Extract a tooth (`extracted: true`) or restore it, while the case runs (see
@@ -167,6 +179,7 @@ impl Plugin for MovementPlugin {
             .add_message::<SetLoad>()
             .add_message::<SetGroupLoad>()
             .add_message::<SetWire>()
+            .add_message::<SetMomentToForce>()
             .add_message::<SetExtracted>()
             .add_message::<ToothImpact>()
             .configure_sets(
@@ -273,15 +286,24 @@ fn edit_teeth(
     mut state: ResMut<SimulationState>,
     case: Option<Res<ActiveCase>>,
     mut wires: MessageReader<SetWire>,
+    mut ratios: MessageReader<SetMomentToForce>,
     mut extractions: MessageReader<SetExtracted>,
     teeth: Query<(Entity, &Tooth, Option<&ToothCollider>, Has<Extracted>)>,
 ) {
     let state = &mut *state;
     let (Some(sim), Some(case)) = (state.sim.as_mut(), case) else {
         wires.clear();
+        ratios.clear();
         extractions.clear();
         return;
     };
+    for m in ratios.read() {
+        if let Some(i) = state.entities.iter().position(|e| *e == m.tooth)
+            && let Err(e) = sim.set_mf(i, m.mf)
+        {
+            state.notice = Some(e.to_string());
+        }
+    }
     for m in wires.read() {
         if let Some(i) = state.entities.iter().position(|e| *e == m.tooth) {
             sim.set_wire(i, m.wire);
@@ -495,6 +517,7 @@ fn commit(
         steps: sim.steps,
         moved: sim.last.moved,
         at_rest: sim.last.at_rest,
+        days: sim.elapsed_days,
         collision_us,
     };
     if *status != new {

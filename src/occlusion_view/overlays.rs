@@ -156,14 +156,35 @@ impl Selection {
 }
 
 const SELECTION_COLOUR: Color = Color::srgb(1.0, 0.85, 0.1);
+const RESISTANCE_COLOUR: Color = Color::srgb(0.2, 0.9, 0.3);
+const ROTATION_COLOUR: Color = Color::srgb(0.95, 0.2, 0.9);
+const BRACKET_COLOUR: Color = Color::srgb(0.3, 0.6, 1.0);
 
-/// Rings around the selected teeth's crowns (extracted ones are selected without a ring).
+/// Rings around the selected teeth's crowns (extracted ones are selected without a ring); under
+/// the PDL model, markers at each one's bracket (blue), centre of resistance (green) and current
+/// centre of rotation (magenta, while it turns).
 pub(super) fn draw_selection(
     selection: Res<Selection>,
     mut gizmos: Gizmos,
     teeth: Query<(&Transform, &crate::teeth::ToothShape), Without<Extracted>>,
+    state: Option<Res<crate::movement::SimulationState>>,
 ) {
+    let sim = state.as_ref().and_then(|s| s.sim.as_ref().map(|sim| (s, sim)));
     for e in &selection.0 {
+        if let Some((s, sim)) = sim
+            && let Some(i) = s.index_of(*e)
+        {
+            let markers = [
+                (sim.bracket(i), 0.25, BRACKET_COLOUR),
+                (sim.centre_of_resistance(i), 0.4, RESISTANCE_COLOUR),
+                (sim.centre_of_rotation(i), 0.4, ROTATION_COLOUR),
+            ];
+            for (p, r, colour) in markers {
+                if let Some(p) = p.filter(|p| p.is_finite() && p.length() < 200.0) {
+                    gizmos.sphere(Isometry3d::from_translation(p), r, colour);
+                }
+            }
+        }
         let Ok((tf, shape)) = teeth.get(*e) else {
             continue;
         };

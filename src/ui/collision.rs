@@ -6,7 +6,7 @@ use bevy_egui::egui;
 use super::PanelState;
 use crate::{
     collision::{CollisionSettings, Method},
-    movement::{MovementSettings, Response},
+    movement::{MovementModel, MovementSettings, Response},
     occlusion_view::Overlays,
     sphere_tree::{SphereTreeProgress, SphereTreeSettings, TreeMethod},
     teeth::LoadCase,
@@ -56,6 +56,17 @@ pub(super) fn section(
         });
     if response != s.movement.response {
         s.movement.response = response;
+    }
+    let mut model = s.movement.model;
+    egui::ComboBox::from_label("movement model")
+        .selected_text(model.name())
+        .show_ui(ui, |ui| {
+            for m in MovementModel::ALL {
+                ui.selectable_value(&mut model, m, m.name());
+            }
+        });
+    if model != s.movement.model {
+        s.movement.model = model;
     }
     let mut chosen = s.state.tree.unwrap_or((s.trees.method, s.trees.depth));
     ui.horizontal(|ui| {

@@ -25,9 +25,10 @@ pub(super) struct Sources<'a, 'w, 's> {
 pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, s: Sources<'_, '_, '_>, dt: f32) {
     ui.heading("Readouts");
     ui.label(format!(
-        "{:.0} fps · step {} · {} teeth moving{}",
+        "{:.0} fps · step {} · {} · {} teeth moving{}",
         1.0 / state.frame.max(1e-6),
         s.status.steps,
+        elapsed(s.status.days),
         s.status.moved,
         if s.status.at_rest { " · at rest" } else { "" }
     ));
@@ -82,6 +83,17 @@ pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, s: Sources<'_, 
 }
 
 /// The gaps (mm) of the labelled pairs, with the 1 mm line.
+/// Elapsed treatment time as a clinician reads it: days, or months past two months.
+fn elapsed(days: f64) -> String {
+    if days >= 61.0 {
+        format!("{:.0} days ({:.1} months)", days, days / 30.44)
+    } else if days >= 1.0 {
+        format!("{days:.0} days")
+    } else {
+        format!("{:.1} s", days * 86_400.0)
+    }
+}
+
 fn gap_plot(ui: &mut egui::Ui, gaps: &[(String, f32)]) {
     let points: Vec<[f64; 2]> = gaps
         .iter()

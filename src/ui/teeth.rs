@@ -6,7 +6,7 @@ use bevy::{ecs::system::SystemParam, prelude::*};
 use bevy_egui::{EguiContexts, egui};
 
 use crate::{
-    movement::{SetExtracted, SetLoad, SetWire, SimulationState},
+    movement::{SetExtracted, SetLoad, SetMomentToForce, SetWire, SimulationState},
     occlusion_view::Selection,
     teeth::{Extracted, Load, Tooth, Wire, WireModel},
 };
@@ -59,6 +59,8 @@ const CHART: [[u8; 16]; 2] = [
 pub(super) struct LoadEditor {
     force_n: f32,
     torque_nmm: f32,
+    /// Moment-to-force ratio at the bracket (mm) for the selected teeth.
+    mf_mm: f32,
 }
 
 impl Default for LoadEditor {
@@ -66,6 +68,7 @@ impl Default for LoadEditor {
         Self {
             force_n: 1.5,
             torque_nmm: 15.0,
+            mf_mm: 10.0,
         }
     }
 }
@@ -89,6 +92,7 @@ type WindowTeeth<'w, 's> = Query<
 pub(super) struct ToothEdits<'w> {
     load: MessageWriter<'w, SetLoad>,
     wire: MessageWriter<'w, SetWire>,
+    mf: MessageWriter<'w, SetMomentToForce>,
     extracted: MessageWriter<'w, SetExtracted>,
 }
 
@@ -110,11 +114,12 @@ pub(super) fn loads_window(
             ui.add(egui::Slider::new(&mut editor.force_n, 0.0..=5.0).text("force N"));
             ui.add(egui::Slider::new(&mut editor.torque_nmm, 0.0..=50.0).text("torque N·mm"));
             loads(ui, &editor, &selection, &teeth, &mut edits.load);
+            moment_to_force(ui, &mut editor, &selection, &mut edits.mf);
             wires_and_extraction(ui, &selection, &mut edits);
             if let Some(notice) = &sim.notice {
                 ui.colored_label(egui::Color32::LIGHT_RED, notice);
             }
-            selected(ui, &selection, &teeth);
+            selected(ui, &selection, &teeth, &sim);
         });
     Ok(())
 }
@@ -213,6 +218,37 @@ fn loads(
     }
 }
 
+/// The bracket's moment-to-force ratio for the selected teeth (PDL model, rectangular wire): 0
+/// tips the crown, about the bracket's distance to the centre of resistance (8–12 mm) translates,
+/// more moves the root.
+fn moment_to_force(
+    ui: &mut egui::Ui,
+    editor: &mut LoadEditor,
+    selection: &Selection,
+    out: &mut MessageWriter<SetMomentToForce>,
+) {
+    let any = !selection.0.is_empty();
+    ui.horizontal_wrapped(|ui| {
+        ui.add(egui::Slider::new(&mut editor.mf_mm, 0.0..=15.0).text("M/F mm"));
+        let mut chosen = None;
+        if ui.add_enabled(any, egui::Button::new("set M/F")).clicked() {
+            chosen = Some(Some(editor.mf_mm));
+        }
+        if ui
+            .add_enabled(any, egui::Button::new("wire decides"))
+            .on_hover_text("no set M/F: a rectangular wire supplies its engagement's couple")
+            .clicked()
+        {
+            chosen = Some(None);
+        }
+        if let Some(mf) = chosen {
+            for e in &selection.0 {
+                out.write(SetMomentToForce { tooth: *e, mf });
+            }
+        }
+    });
+}
+
 /// Round or rectangular wire, extract or restore, for every selected tooth.
 fn wires_and_extraction(ui: &mut egui::Ui, selection: &Selection, edits: &mut ToothEdits) {
     ui.horizontal_wrapped(|ui| {
@@ -240,8 +276,9 @@ fn wires_and_extraction(ui: &mut egui::Ui, selection: &Selection, edits: &mut To
     });
 }
 
-/// Each selected tooth's load and wire, or that it is extracted.
-fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth) {
+/// Each selected tooth's load, wire and M/F, or that it is extracted; under the PDL model where
+/// its centres of resistance and rotation are (drawn as markers: green and magenta).
+fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth, sim: &SimulationState) {
     for e in &selection.0 {
         let Ok((_, tooth, _, l, extracted, wire)) = teeth.get(*e) else {
             continue;
@@ -254,11 +291,32 @@ fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth) {
             Some(WireModel::Round) => "round",
             _ => "rectangular",
         };
+        let run = sim.sim.as_ref().zip(sim.index_of(*e));
+        let mf = run
+            .and_then(|(s, i)| s.teeth[i].mf)
+            .map_or(String::new(), |m| format!(", M/F {m:.1} mm"));
         ui.label(format!(
-            "{}: force {:.2} N, torque {:.1} N·mm, {wire} wire",
+            "{}: force {:.2} N, torque {:.1} N·mm, {wire} wire{mf}",
             tooth.id,
             l.force.length(),
             l.torque.length()
         ));
+        if let Some((s, i)) = run
+            && let Some(cres) = s.centre_of_resistance(i)
+        {
+            let t = &s.teeth[i];
+            let axis = t.pose.transform_vector(t.shape.geometry.frame.long_axis);
+            let rotation = match s.centre_of_rotation(i) {
+                Some(c) => format!(
+                    "centre of rotation {:+.1} mm along the axis (+ apical)",
+                    (cres - c).dot(axis)
+                ),
+                None if s.pdl.twists.get(i).is_some_and(|t| t.iter().any(|v| *v != 0.0)) => {
+                    "translating".to_owned()
+                }
+                None => "at rest".to_owned(),
+            };
+            ui.label(format!("    {rotation}"));
+        }
     }
 }

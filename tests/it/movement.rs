@@ -198,7 +198,12 @@ fn case2_moves_first_molars_and_first_premolars_not_canines() {
             &[16, 26, 36, 46, 14, 24, 34, 44],
             &[13, 23, 33, 43, 12, 22, 32, 42],
         );
-        let limit = if method == Method::Exact { 0.011 } else { 0.5 };
+        // Spheres stop teeth where leaf spheres overlap, up to about their fit from the mesh.
+        let limit = match method {
+            Method::Exact => 0.011,
+            Method::Spheres => 0.6,
+            _ => 0.5,
+        };
         for (a, b) in [(16, 14), (24, 26), (46, 44), (34, 36)] {
             let g = gap(&r, a, b);
             assert!(g <= limit, "{method:?} {model}: {a}-{b} gap {g}");
@@ -209,7 +214,11 @@ fn case2_moves_first_molars_and_first_premolars_not_canines() {
 #[test]
 fn case3_closes_the_diastemas() {
     for (model, method) in models_and_methods() {
-        let limit = if method == Method::Exact { 0.011 } else { 0.15 };
+        let limit = match method {
+            Method::Exact => 0.011,
+            Method::Spheres => 0.25,
+            _ => 0.15,
+        };
         let r = check_case("case3", method, model, &[11, 21, 31, 41], &[13, 23, 33, 43]);
         for (a, b) in [(11, 21), (41, 31)] {
             let g = gap(&r, a, b);

@@ -13,10 +13,11 @@
 //! moves by β × its initial elastic twist `C w`, shrunk so that the ligament's mean pressure
 //! drops by the threshold, where `w` is the wrench of its loads and contact forces about its
 //! centre of resistance. Either wire keeps the bracket on its path (`wire_holds_brackets`): the
-//! bracket slides along the arch but not across it (buccolingually or vertically). A rectangular
-//! wire also supplies `wire_engagement` of the couple that would stop the tooth turning, or the
-//! couple M/F × F a load asks for; a round wire supplies no couple, so the tooth tips about its
-//! bracket.
+//! bracket slides along the arch but not across it (buccolingually or vertically), except in the
+//! direction of the tooth's own force, which is what the appliance delivers. A rectangular wire
+//! also supplies `wire_engagement` of the couple that would stop the tooth turning (about every
+//! axis but that of the tooth's own torque), or the couple M/F × F a load asks for; a round wire
+//! supplies no couple, so the tooth tips about its bracket.
 
 mod body;
 mod contact;

@@ -20,7 +20,7 @@ use crate::{
         model::{Drive, angle_between},
         pdl::{
             ContactRow, PdlBody, PdlStiffness, SolveParams, blocked, centre_of_elasticity,
-            constrained_compliance, engaged, rotated, shifted, solve_contacts, wrench,
+            constrained_compliance, rotated, shifted, solve_contacts, wrench,
         },
     },
     teeth::WireModel,
@@ -46,6 +46,31 @@ pub struct PdlState {
     pub wrenches: Vec<Vec6>,
     /// Sweeps of the last contact solve.
     pub sweeps: usize,
+}
+
+/// The directions among `axes` (orthonormal) that the wire holds when the appliance's own load
+/// is `load`: all of them, less the load's own direction within their span (the load is what the
+/// appliance delivers, so the wire does not resist it; it resists everything else).
+fn held_directions<const N: usize>(axes: [Vec3; N], load: Vec3) -> Vec<DVec3> {
+    let axes = axes.map(|a| a.as_dvec3());
+    let load = load.as_dvec3();
+    let within: DVec3 = axes.iter().map(|a| *a * a.dot(load)).sum();
+    let Some(free) = within.try_normalize().filter(|_| within.length() > 1e-6 * load.length())
+    else {
+        return axes.to_vec();
+    };
+    // An orthonormal basis of the span without `free`: Gram–Schmidt on the axes.
+    let mut out: Vec<DVec3> = Vec::new();
+    for a in axes {
+        let mut v = a - free * free.dot(a);
+        for o in &out {
+            v -= *o * o.dot(v);
+        }
+        if let Some(v) = v.try_normalize().filter(|_| v.length() > 1e-6) {
+            out.push(v);
+        }
+    }
+    out
 }
 
 /// One body of the step: its members and its ligament.
@@ -176,12 +201,9 @@ impl Simulation {
         if s.wire_holds_brackets {
             let frame = self.arch_frame(lead);
             let b = bracket.as_dvec3() - centre;
-            let across: Vec<Vec6> = [frame.buccal, frame.up]
+            let across: Vec<Vec6> = held_directions([frame.buccal, frame.up], force)
                 .into_iter()
-                .map(|n| {
-                    let n = n.as_dvec3();
-                    vec6(n, b.cross(n))
-                })
+                .map(|n| vec6(n, b.cross(n)))
                 .collect();
             compliance = blocked(&compliance, &across, 1.0);
         }
@@ -191,7 +213,11 @@ impl Simulation {
                 couple -= (axis.cross(force) * mf).as_dvec3();
             }
             (WireModel::Rectangular, None) => {
-                compliance = engaged(&compliance, s.wire_engagement as f64);
+                let turns: Vec<Vec6> = held_directions([Vec3::X, Vec3::Y, Vec3::Z], torque)
+                    .into_iter()
+                    .map(|n| vec6(DVec3::ZERO, n))
+                    .collect();
+                compliance = blocked(&compliance, &turns, s.wire_engagement as f64);
             }
             (WireModel::Round, _) => {}
         }
