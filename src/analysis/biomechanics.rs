@@ -31,9 +31,7 @@ use crate::{
         pdl::{PdlStiffness, displacement_at, wrench},
     },
     sphere_tree::{TreeMethod, TreeSettings},
-    teeth::{
-        Arch, Case, Dentition, Fdi, ToothGeometry, ToothKind, ToothResolution, WireModel,
-    },
+    teeth::{Arch, Case, Dentition, Fdi, ToothGeometry, ToothKind, ToothResolution, WireModel},
 };
 
 /// Accepted σ²/h²: the 2D Winkler values of a cone (0.056) and a paraboloid (0.068), each
@@ -298,7 +296,9 @@ pub fn canine_retraction(settings: &MovementSettings, days: f64) -> Result<f64, 
         ..*settings
     };
     let mut sim = Simulation::new(&d, shapes, Method::Continuous, settings)?;
-    let i = sim.index_of(canine).ok_or(MovementError::NotInCase(canine))?;
+    let i = sim
+        .index_of(canine)
+        .ok_or(MovementError::NotInCase(canine))?;
     let start = sim.teeth[i].crown_centre();
     while sim.elapsed_days < days - 1e-9 {
         if sim.step().at_rest && sim.elapsed_days > 0.0 {

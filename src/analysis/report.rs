@@ -98,6 +98,8 @@ pub struct Summary {
     pub ipr: BTreeMap<String, Vec<IprEntry>>,
     /// Occlusal contacts per tooth at the end of the exact run with the bite closed, per case.
     pub occlusion: BTreeMap<String, Vec<OcclusalContact>>,
+    /// The PDL model beside published biomechanics (`orthosim validate`).
+    pub biomechanics: super::Validation,
 }
 
 /// A row of `distances.csv`.
@@ -304,12 +306,14 @@ pub fn run_report(
             .tooth(f)
             .map_or(f32::NAN, |t| t.geometry.anatomy.mesiodistal)
     };
+    let biomechanics = super::validate(&opts.settings, crate::teeth::ToothResolution::default())?;
     let summary = Summary {
         cases,
         tree_fit,
         bolton: bolton(width, [&arches[0], &arches[1]]),
         ipr,
         occlusion,
+        biomechanics,
     };
     write_atomic(
         &out.join("summary.json"),
@@ -444,6 +448,22 @@ adjacent pair, one series per algorithm. <a href=\"{0}.png\">PNG</a> · \
                 ants.join(" ")
             );
         }
+    }
+    h.push_str("</table>\n<h2>Tooth movement beside published biomechanics (PDL model, <code>orthosim validate</code>)</h2>\n<table><tr><th class=\"l\">quantity</th><th>tooth</th><th>M/F mm</th><th>value</th><th>accepted</th><th class=\"l\">unit</th><th class=\"l\">source</th><th class=\"l\">inside</th></tr>\n");
+    for r in &s.biomechanics.rows {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td></tr>",
+            r.name,
+            r.tooth,
+            r.mf.map_or(String::new(), |m| format!("{m:.0}")),
+            r.value,
+            r.reference
+                .map_or("—".to_owned(), |[lo, hi]| format!("{lo:.3}–{hi:.3}")),
+            escape(r.unit),
+            escape(r.source),
+            if r.passes() { "yes" } else { "no" }
+        );
     }
     h.push_str("</table>\n</body></html>\n");
     h

@@ -5,6 +5,7 @@ use anyhow::Result;
 use clap::Args;
 use orthosim::{
     collision::bench::{self, MethodReport},
+    movement::bench::{PdlBench, pdl_bench},
     teeth::{Case, Dentition},
 };
 
@@ -89,8 +90,28 @@ pub fn run(args: BenchArgs) -> Result<()> {
         }
     };
     let report = bench::run(&teeth, &near, &stress, &bar);
+    if progress {
+        eprint!("timing the PDL model…");
+    }
+    let vertices = match args.resolution {
+        BenchResolution::Vertices(n) => Some(n),
+        BenchResolution::Default => None,
+    };
+    let pdl = pdl_bench(vertices, 200)?;
+    if progress {
+        eprintln!();
+    }
     if args.json {
-        return print_json(&report);
+        #[derive(serde::Serialize)]
+        struct Output<'a> {
+            #[serde(flatten)]
+            report: &'a bench::BenchReport,
+            pdl: &'a PdlBench,
+        }
+        return print_json(&Output {
+            report: &report,
+            pdl: &pdl,
+        });
     }
     let tree = args.trees.tree;
     table(
@@ -111,6 +132,26 @@ pub fn run(args: BenchArgs) -> Result<()> {
         "full-mouth step (continuous): {:.1} µs",
         report.full_mouth_step_us
     );
+    for (what, t) in [
+        ("case resolution", &pdl.stiffness_case_resolution),
+        ("scan resolution", &pdl.stiffness_scan_resolution),
+    ] {
+        println!(
+            "PDL stiffness, upper first molar at {what} ({} triangles): {:.2} ms (median of {}, {:.2}–{:.2})",
+            t.triangles, t.ms, t.runs, t.range_ms[0], t.range_ms[1]
+        );
+    }
+    for s in &pdl.steps {
+        println!(
+            "case 1 step ({}, {} steps): loads and motion {:.1} µs, of which contact solve {:.1} µs ({:.1} contacts); collision {:.1} µs",
+            s.model,
+            s.steps,
+            s.motion_us_per_step,
+            s.contact_solve_us_per_step,
+            s.mean_contacts,
+            s.collision_us_per_step
+        );
+    }
     Ok(())
 }
 

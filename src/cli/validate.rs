@@ -33,7 +33,12 @@ pub fn run(args: ValidateArgs) -> Result<()> {
         Some(path) => MovementSettings::load(path)?,
         None => MovementSettings::default(),
     };
-    let table = validate(&settings, ToothResolution { vertices: args.vertices })?;
+    let table = validate(
+        &settings,
+        ToothResolution {
+            vertices: args.vertices,
+        },
+    )?;
     if args.json {
         print_json(&table)?;
     } else {

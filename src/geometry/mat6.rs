@@ -17,10 +17,7 @@ pub fn vec6(a: DVec3, b: DVec3) -> Vec6 {
 
 /// The two halves of a 6-vector.
 pub fn halves(v: &Vec6) -> (DVec3, DVec3) {
-    (
-        DVec3::new(v[0], v[1], v[2]),
-        DVec3::new(v[3], v[4], v[5]),
-    )
+    (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]))
 }
 
 impl Mat6 {

@@ -45,7 +45,9 @@ pub fn section_loops(mesh: &TriMesh, point: Vec3, normal: Vec3) -> usize {
             parent[rx] = ry;
         }
     }
-    (0..parent.len()).filter(|&i| find(&mut parent, i) == i).count()
+    (0..parent.len())
+        .filter(|&i| find(&mut parent, i) == i)
+        .count()
 }
 
 #[cfg(test)]

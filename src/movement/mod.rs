@@ -8,6 +8,7 @@
 //! `MovementPlugin`.
 
 mod arch_path;
+pub mod bench;
 mod error;
 mod model;
 pub mod pdl;
@@ -22,8 +23,7 @@ pub use model::ToothConstraint;
 #[cfg(feature = "ecs")]
 pub use plugin::{
     MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad, SetLoad,
-    SetMomentToForce, SetWire,
-    SimulationState, ToothImpact,
+    SetMomentToForce, SetWire, SimulationState, ToothImpact,
 };
 pub use report::{
     CaseRun, MOVED_MM, PairDistance, SimulationReport, ToothTravel, max_penetration,

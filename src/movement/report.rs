@@ -56,7 +56,9 @@ pub fn tooth_travel(sim: &Simulation) -> Vec<ToothTravel> {
         .map(|(i, t)| {
             let f = &t.shape.geometry.frame;
             let tip = f.cervical_centre + f.long_axis * f.crown_length;
-            let moved = |p: glam::Vec3| (t.pose.transform_point(p) - t.initial.transform_point(p)).to_array();
+            let moved = |p: glam::Vec3| {
+                (t.pose.transform_point(p) - t.initial.transform_point(p)).to_array()
+            };
             ToothTravel {
                 fdi: t.fdi,
                 crown_displacement_mm: moved(tip),

@@ -52,10 +52,12 @@ pub enum MovementModel {
     /// at the bracket, contact forces solved between touching teeth, bone remodelling in
     /// clinical time ([`crate::movement::pdl`]).
     #[default]
+    #[serde(alias = "Pdl")]
     Pdl,
     /// The source paper's: velocity = mobility × (|load| − threshold), bodily under a rectangular
     /// wire, tipping about a third of the root from the apex under a round one, half the load
     /// passed to a blocking neighbour, 1/64 s steps.
+    #[serde(alias = "Paper")]
     Paper,
 }
 

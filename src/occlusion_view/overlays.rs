@@ -169,7 +169,9 @@ pub(super) fn draw_selection(
     teeth: Query<(&Transform, &crate::teeth::ToothShape), Without<Extracted>>,
     state: Option<Res<crate::movement::SimulationState>>,
 ) {
-    let sim = state.as_ref().and_then(|s| s.sim.as_ref().map(|sim| (s, sim)));
+    let sim = state
+        .as_ref()
+        .and_then(|s| s.sim.as_ref().map(|sim| (s, sim)));
     for e in &selection.0 {
         if let Some((s, sim)) = sim
             && let Some(i) = s.index_of(*e)

@@ -311,7 +311,12 @@ fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth, sim: 
                     "centre of rotation {:+.1} mm along the axis (+ apical)",
                     (cres - c).dot(axis)
                 ),
-                None if s.pdl.twists.get(i).is_some_and(|t| t.iter().any(|v| *v != 0.0)) => {
+                None if s
+                    .pdl
+                    .twists
+                    .get(i)
+                    .is_some_and(|t| t.iter().any(|v| *v != 0.0)) =>
+                {
                     "translating".to_owned()
                 }
                 None => "at rest".to_owned(),

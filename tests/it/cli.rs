@@ -144,7 +144,7 @@ fn help_lists_the_subcommands() {
     let out = orthosim(&["--help"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    for sub in ["view", "cases", "inspect", "trees"] {
+    for sub in ["view", "cases", "inspect", "trees", "validate"] {
         assert!(text.contains(sub), "{text}");
     }
 }
@@ -369,9 +369,25 @@ fn simulate_reports_the_contract_keys() {
         "total_centre_distance_mm",
         "collision_us_per_step",
         "step_us",
+        "model",
+        "days",
+        "teeth",
     ] {
         assert!(v.get(key).is_some(), "missing {key}: {v}");
     }
+    assert_eq!(v["model"], "pdl");
+    let teeth = v["teeth"].as_array().unwrap();
+    assert_eq!(teeth.len(), 32);
+    for t in teeth {
+        assert!(t["fdi"].as_u64().is_some(), "{t}");
+        for key in ["crown_displacement_mm", "apex_displacement_mm"] {
+            assert_eq!(t[key].as_array().map(|a| a.len()), Some(3), "{t}");
+        }
+        assert!(t["rotation_deg"].as_f64().is_some(), "{t}");
+    }
+    // A day a step by default.
+    let steps = v["steps"].as_f64().unwrap();
+    assert!((v["days"].as_f64().unwrap() - steps).abs() < 1e-6);
     assert_eq!(v["case"], "case3");
     assert_eq!(v["algorithm"], "circles");
     assert_eq!(v["response"], "block");
@@ -389,6 +405,50 @@ fn simulate_reports_the_contract_keys() {
         .map(|d| d["centre_distance_mm"].as_f64().unwrap())
         .sum();
     assert!((total - v["total_centre_distance_mm"].as_f64().unwrap()).abs() < 1e-3);
+}
+
+#[test]
+fn simulate_takes_either_model_and_validate_prints_its_rows() {
+    let out = succeed(&[
+        "simulate",
+        "--case",
+        "case3",
+        "--model",
+        "paper",
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--max-steps",
+        "20",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "paper");
+    let seconds = v["days"].as_f64().unwrap() * 86_400.0;
+    assert!(
+        (seconds - v["steps"].as_f64().unwrap() / 64.0).abs() < 1e-6,
+        "{v}"
+    );
+    let out = orthosim(&["simulate", "--model", "springs"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("pdl") && err.contains("paper"), "{err}");
+
+    let out = succeed(&["validate", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "pdl");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 16);
+    for r in rows {
+        for key in ["name", "tooth", "value", "unit", "reference", "source"] {
+            assert!(r.get(key).is_some(), "{key} missing: {r}");
+        }
+    }
+    assert!(rows.iter().any(|r| r["mf"].as_f64() == Some(12.0)));
+    let table = succeed(&["validate"]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(text.contains("canine_retraction_mm_per_month_1n"), "{text}");
+    assert!(!text.contains("OUTSIDE"), "{text}");
 }
 
 #[test]

@@ -13,6 +13,7 @@ mod movement;
 mod occlusion_measures;
 mod oracle;
 mod parry_support;
+mod pdl;
 mod scans;
 mod schedule;
 mod stress;

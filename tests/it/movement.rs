@@ -293,7 +293,10 @@ fn the_same_run_gives_bit_identical_poses() {
         let (a, b) = (poses(), poses());
         assert!(a.iter().zip(&b).all(|(x, y)| x == y), "{model}");
         assert!(a.iter().all(|p| p.is_finite()), "{model}");
-        assert!(a != d.visible().map(|t| t.pose).collect::<Vec<_>>(), "{model}: nothing moved");
+        assert!(
+            a != d.visible().map(|t| t.pose).collect::<Vec<_>>(),
+            "{model}: nothing moved"
+        );
     }
 }
 
@@ -358,7 +361,12 @@ fn impulse_conserves_momentum_and_never_gains_energy() {
 
 #[test]
 fn ipr_records_the_overlap_within_its_limit() {
-    let r = run("case3", Method::Continuous, MovementModel::Paper, Response::Ipr);
+    let r = run(
+        "case3",
+        Method::Continuous,
+        MovementModel::Paper,
+        Response::Ipr,
+    );
     let limit = settings(MovementModel::Paper, Response::Ipr).ipr_limit_mm;
     let upper = r.report.ipr_mm.get("11-21").copied().unwrap_or(0.0);
     let lower = r.report.ipr_mm.get("41-31").copied().unwrap_or(0.0);

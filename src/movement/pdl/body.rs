@@ -227,7 +227,10 @@ mod tests {
         let k = spd();
         let c = k.inverse().unwrap();
         // Only x translation and z rotation allowed.
-        let allowed = [[1.0, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]];
+        let allowed = [
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        ];
         let cc = constrained_compliance(&k, &allowed).unwrap();
         let t = cc.mul_vec(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         assert!(t[1].abs() < 1e-12 && t[2].abs() < 1e-12 && t[3].abs() < 1e-12);

@@ -158,10 +158,7 @@ mod tests {
                 compliance: Mat6::identity(),
                 area: 1.0,
                 mean_spring: 1.0,
-                applied: vec6(
-                    DVec3::X * if i == 0 { push } else { 0.0 },
-                    DVec3::ZERO,
-                ),
+                applied: vec6(DVec3::X * if i == 0 { push } else { 0.0 }, DVec3::ZERO),
             })
             .collect()
     }
@@ -207,8 +204,15 @@ mod tests {
         let bodies = row(4, 2.5);
         let s = solve_contacts(&bodies, &contacts(4), None, &params(1.0e3));
         // 2.5 N: the first two teeth hold 1 N each, the third 0.5 N: nothing moves.
-        assert!(s.twists.iter().all(|t| t.iter().all(|v| v.abs() < 1e-9)), "{s:?}");
-        assert!(s.forces[2] < 1e-6, "the fourth tooth feels nothing: {:?}", s.forces);
+        assert!(
+            s.twists.iter().all(|t| t.iter().all(|v| v.abs() < 1e-9)),
+            "{s:?}"
+        );
+        assert!(
+            s.forces[2] < 1e-6,
+            "the fourth tooth feels nothing: {:?}",
+            s.forces
+        );
         assert!(s.residual < 1e-9);
         // 4 N: the row moves, and it moves slower than without thresholds.
         let s = solve_contacts(&row(4, 4.0), &contacts(4), None, &params(0.5e3));

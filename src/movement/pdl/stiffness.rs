@@ -188,7 +188,7 @@ impl PdlStiffness {
     /// root cannot resist every rigid motion.
     pub fn of(geometry: &ToothGeometry, settings: &PdlSettings) -> Result<Self, PdlError> {
         let crest_mm = settings.crest_mm.of(geometry.kind);
-        Self::of_mesh(&geometry.mesh, &geometry.frame, crest_mm, settings)
+        Self::of_mesh(geometry.mesh_ref(), &geometry.frame, crest_mm, settings)
     }
 
     /// [`PdlStiffness::of`] for a mesh, its frame and a crest depth (mm below the cervical line).
@@ -196,7 +196,7 @@ impl PdlStiffness {
     /// # Errors
     /// As [`PdlStiffness::of`].
     pub fn of_mesh(
-        mesh: &TriMesh,
+        m: MeshRef,
         frame: &ToothFrame,
         crest_mm: f32,
         settings: &PdlSettings,
@@ -205,20 +205,20 @@ impl PdlStiffness {
         let origin = frame.cervical_centre;
         let crest_level = -crest_mm;
         let root_mm = frame.root_length;
-        let points = root_points(mesh, origin, axis, crest_level);
+        let points = root_points(m.mesh, origin, axis, crest_level);
         let root_area_mm2: f64 = points.iter().map(|p| p.area).sum();
         if root_mm <= crest_mm || root_area_mm2 <= 1e-6 {
             return Err(PdlError::NoRoot { crest_mm, root_mm });
         }
         let (kn, kt) = settings.layer_stiffness(settings.youngs_modulus_mpa);
         let about_origin = stiffness_about(&points, origin.as_dvec3(), kn, kt, |_| 1.0);
-        let cres = centre_of_elasticity(&about_origin, origin.as_dvec3()).ok_or(PdlError::Singular)?;
+        let cres =
+            centre_of_elasticity(&about_origin, origin.as_dvec3()).ok_or(PdlError::Singular)?;
         let stiffness = stiffness_about(&points, cres, kn, kt, |_| 1.0);
         let compliance = stiffness.inverse().ok_or(PdlError::Singular)?;
         let crown_height = frame.crown_length * settings.bracket_height;
         let from = origin + axis * crown_height;
-        let bvh = crate::geometry::TriangleBvh::build(mesh);
-        let bracket = ray_first_hit(MeshRef { mesh, bvh: &bvh }, from, frame.buccolingual, 0.0)
+        let bracket = ray_first_hit(m, from, frame.buccolingual, 0.0)
             .map_or(frame.crown_centre, |t| from + frame.buccolingual * t);
         Ok(Self {
             stiffness,
@@ -259,7 +259,12 @@ impl PdlStiffness {
         settings: &PdlSettings,
         w: &Vec6,
     ) -> Option<Vec6> {
-        let points = root_points(mesh, frame.cervical_centre, frame.long_axis, self.crest_level);
+        let points = root_points(
+            mesh,
+            frame.cervical_centre,
+            frame.long_axis,
+            self.crest_level,
+        );
         let cres = self.centre_of_resistance.as_dvec3();
         let (kn, kt) = settings.layer_stiffness(settings.youngs_modulus_mpa);
         let (e1, e2) = (
@@ -331,11 +336,14 @@ mod tests {
         for dir in [lingual, g.frame.mesiodistal.as_dvec3()] {
             let t = p.compliance.mul_vec(&vec6(dir, DVec3::ZERO));
             let (u, theta) = halves(&t);
-            let at_bracket = p
-                .compliance
-                .mul_vec(&wrench(dir, p.bracket.as_dvec3(), DVec3::ZERO, c));
+            let at_bracket =
+                p.compliance
+                    .mul_vec(&wrench(dir, p.bracket.as_dvec3(), DVec3::ZERO, c));
             assert!(u.dot(dir) > 0.0);
-            assert!(theta.length() < 0.02 * halves(&at_bracket).1.length(), "{u} {theta}");
+            assert!(
+                theta.length() < 0.02 * halves(&at_bracket).1.length(),
+                "{u} {theta}"
+            );
         }
         // The same force at the bracket tips the crown lingually and the apex labially.
         let w = wrench(lingual, p.bracket.as_dvec3(), DVec3::ZERO, c);
@@ -366,7 +374,10 @@ mod tests {
                 let id: f64 = (0..6)
                     .map(|k| p.stiffness.0[r][k] * p.compliance.0[k][c])
                     .sum();
-                assert!((id - if r == c { 1.0 } else { 0.0 }).abs() < 1e-8, "{r} {c} {id}");
+                assert!(
+                    (id - if r == c { 1.0 } else { 0.0 }).abs() < 1e-8,
+                    "{r} {c} {id}"
+                );
             }
             assert!(p.stiffness.0[r][r] > 0.0);
         }
@@ -424,6 +435,10 @@ mod tests {
         let w = wrench(lingual * 5.0, p.bracket.as_dvec3(), DVec3::ZERO, c);
         let t = p.bilinear_twist(&g.mesh, &g.frame, &linear, &w).unwrap();
         let lin = p.compliance.mul_vec(&w);
-        assert!(t.iter().zip(&lin).all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs().max(1e-9)));
+        assert!(
+            t.iter()
+                .zip(&lin)
+                .all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs().max(1e-9))
+        );
     }
 }

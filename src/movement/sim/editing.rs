@@ -166,6 +166,7 @@ impl Simulation {
             }
         }
         self.settings = settings;
+        self.pdl.cache.clear();
         if settings.model == MovementModel::Pdl
             && let Err(e) = self.prepare_pdl()
         {

@@ -198,6 +198,11 @@ pub struct StepOutcome {
     pub queries: usize,
     /// Time spent in collision detection and response (ns).
     pub collision_ns: u64,
+    /// Time spent on loads and motion (ns): under the PDL model the bodies, the contact solve
+    /// and the motions.
+    pub motion_ns: u64,
+    /// Of which the contact solve (ns, PDL model).
+    pub contact_solve_ns: u64,
     /// Contacts as the step ended (for the last motions tested of each pair).
     pub contacts: Vec<Found>,
     /// Contacts that stopped a tooth in this step, as found when they stopped it.
@@ -321,7 +326,9 @@ impl Simulation {
 
     /// One whole step: propose, detect, respond, commit.
     pub fn step(&mut self) -> &StepOutcome {
+        let t = Instant::now();
         self.propose();
+        let motion_ns = t.elapsed().as_nanos() as u64;
         let t0 = Instant::now();
         let pairs = self.broad_pairs();
         let found = self.narrow(&pairs);
@@ -330,6 +337,8 @@ impl Simulation {
         self.last.pairs_tested = tested;
         self.last.queries += tested;
         self.last.collision_ns = t0.elapsed().as_nanos() as u64;
+        self.last.motion_ns = motion_ns;
+        self.last.contact_solve_ns = self.pdl.solve_ns;
         self.commit();
         &self.last
     }
@@ -390,7 +399,8 @@ impl Simulation {
             MovementModel::Paper => self.settings.step_s as f64 / 86_400.0,
         };
         if self.settings.model == MovementModel::Pdl {
-            let before: Vec<(usize, usize)> = self.pdl.touching.iter().map(|f| (f.a, f.b)).collect();
+            let before: Vec<(usize, usize)> =
+                self.pdl.touching.iter().map(|f| (f.a, f.b)).collect();
             self.carry_contacts();
             let after: Vec<(usize, usize)> = self.pdl.touching.iter().map(|f| (f.a, f.b)).collect();
             // Nothing moved and the contacts are the same: the next solve is this one again.

@@ -46,6 +46,11 @@ pub struct PdlState {
     pub wrenches: Vec<Vec6>,
     /// Sweeps of the last contact solve.
     pub sweeps: usize,
+    /// Time of the last contact solve (ns).
+    pub solve_ns: u64,
+    /// Each single tooth's body as last made, with what it was made from (a body is made again
+    /// only when its pose, load, wire or M/F change).
+    pub cache: Vec<Option<(BodyKey, PdlBody)>>,
 }
 
 /// The directions among `axes` (orthonormal) that the wire holds when the appliance's own load
@@ -55,7 +60,9 @@ fn held_directions<const N: usize>(axes: [Vec3; N], load: Vec3) -> Vec<DVec3> {
     let axes = axes.map(|a| a.as_dvec3());
     let load = load.as_dvec3();
     let within: DVec3 = axes.iter().map(|a| *a * a.dot(load)).sum();
-    let Some(free) = within.try_normalize().filter(|_| within.length() > 1e-6 * load.length())
+    let Some(free) = within
+        .try_normalize()
+        .filter(|_| within.length() > 1e-6 * load.length())
     else {
         return axes.to_vec();
     };
@@ -71,6 +78,15 @@ fn held_directions<const N: usize>(axes: [Vec3; N], load: Vec3) -> Vec<DVec3> {
         }
     }
     out
+}
+
+/// What a tooth's body depends on besides the settings and its constraints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyKey {
+    pose: Pose,
+    load: crate::teeth::Load,
+    wire: WireModel,
+    mf: Option<f32>,
 }
 
 /// One body of the step: its members and its ligament.
@@ -96,12 +112,10 @@ impl Simulation {
                 t.pdl = Some(p.clone());
                 continue;
             }
-            let p = Arc::new(PdlStiffness::of(g, &self.settings.pdl).map_err(|source| {
-                MovementError::Pdl {
-                    fdi: t.fdi,
-                    source,
-                }
-            })?);
+            let p = Arc::new(
+                PdlStiffness::of(g, &self.settings.pdl)
+                    .map_err(|source| MovementError::Pdl { fdi: t.fdi, source })?,
+            );
             made.push((key, p.clone()));
             t.pdl = Some(p);
         }
@@ -238,15 +252,50 @@ impl Simulation {
     /// Loads and motion under the PDL model (see the module doc).
     pub(super) fn propose_pdl(&mut self) {
         let n = self.teeth.len();
+        // Only loaded teeth and teeth in contact can move: the others are not bodies this step.
+        let loaded = |l: &crate::teeth::Load| l.force != Vec3::ZERO || l.torque != Vec3::ZERO;
+        let mut needed: Vec<bool> = self.teeth.iter().map(|t| loaded(&t.load)).collect();
+        for f in &self.pdl.touching {
+            needed[f.a] = true;
+            needed[f.b] = true;
+        }
+        if self.pdl.cache.len() != n {
+            self.pdl.cache = vec![None; n];
+        }
         let mut units = Vec::new();
         for i in 0..n {
-            if self.teeth[i].group.is_none() {
-                let l = self.teeth[i].load;
-                units.extend(self.unit(vec![i], l.force, l.torque));
+            let t = &self.teeth[i];
+            if t.group.is_some() || !needed[i] {
+                continue;
             }
+            let key = BodyKey {
+                pose: t.pose,
+                load: t.load,
+                wire: t.wire,
+                mf: t.mf,
+            };
+            let cached = self.pdl.cache[i]
+                .as_ref()
+                .filter(|(k, _)| *k == key)
+                .map(|(_, b)| b.clone());
+            let body = match cached {
+                Some(b) => Some(b),
+                None => {
+                    let made = self
+                        .unit(vec![i], t.load.force, t.load.torque)
+                        .map(|u| u.body);
+                    self.pdl.cache[i] = made.clone().map(|b| (key, b));
+                    made
+                }
+            };
+            units.extend(body.map(|body| Unit {
+                members: vec![i],
+                body,
+            }));
         }
         for g in &self.groups {
-            if !g.members.is_empty() {
+            let wanted = g.members.iter().any(|&i| needed[i]) || loaded(&g.load);
+            if !g.members.is_empty() && wanted {
                 units.extend(self.unit(g.members.clone(), g.load.force, g.load.torque));
             }
         }
@@ -285,6 +334,7 @@ impl Simulation {
             .iter()
             .map(|&k| self.pdl.forces.get(k).copied().unwrap_or(0.0))
             .collect();
+        let clock = std::time::Instant::now();
         let mut solve = solve_contacts(&bodies, &rows, Some(&warm), &params);
         // Touching teeth that move together open by the bias (see the module doc).
         let moving = |t: &Vec6| t.iter().any(|v| *v != 0.0);
@@ -302,6 +352,7 @@ impl Simulation {
             solve = solve_contacts(&bodies, &rows, Some(&solve.forces), &params);
         }
         self.pdl.sweeps = solve.sweeps;
+        self.pdl.solve_ns = clock.elapsed().as_nanos() as u64;
         let mut forces = vec![0.0; self.pdl.touching.len()];
         for (r, &k) in row_of.iter().enumerate() {
             forces[k] = solve.forces[r];
