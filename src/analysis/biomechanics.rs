@@ -16,8 +16,8 @@
 //! | `canine_retraction_mm_per_month_1n` | upper canine, first premolar extracted, 1 N distal on a rectangular wire: distal travel of its crown in 30 days | 0.71 mm (Monini et al. 2019, maxilla); accepted 0.6–0.8 |
 //!
 //! h is the root length below the crest. `reference` in the output is the accepted range: the
-//! published one with the tolerance the row's source states. The canine row is what the remodelling rate β is
-//! calibrated on; the others do not depend on β.
+//! published one with the tolerance the row's source states. The canine row is what the
+//! remodelling rate β is calibrated on; the others do not depend on β.
 
 use glam::{DVec3, Vec3};
 use serde::Serialize;
@@ -251,7 +251,7 @@ pub fn validate(
             value: displacement_at(&t, c, tip).length(),
             unit: "mm",
             reference: Some([0.12, 0.23]),
-            source: "0.175 mm, upper lateral incisor, in vivo and FE (AADR 2012 abstract 157852)",
+            source: "0.175 mm, upper lateral incisor, in vivo and FE (AADR 2012 abstract 157852); ±30 %",
         });
     }
     rows.push(ValidationRow {
@@ -261,7 +261,7 @@ pub fn validate(
         value: canine_retraction(settings, 30.0)?,
         unit: "mm",
         reference: Some([0.6, 0.8]),
-        source: "0.71 mm/month at 100 g, maxilla (Monini et al., Angle Orthod 2019;89:559)",
+        source: "0.71 mm/month at 100 g, maxilla (Monini et al., Angle Orthod 2019;89:559); β is calibrated on it; ±0.1 mm",
     });
     Ok(Validation {
         model: "pdl",

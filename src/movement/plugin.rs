@@ -245,10 +245,11 @@ fn start_simulation(
         if sim.method != collision.method {
             sim.method = collision.method;
         }
-        if settings.is_changed() && sim.settings != *settings {
-            if let Err(e) = sim.set_settings(*settings) {
-                error!("{e}; keeping the previous movement settings");
-            }
+        if settings.is_changed()
+            && sim.settings != *settings
+            && let Err(e) = sim.set_settings(*settings)
+        {
+            error!("{e}; keeping the previous movement settings");
         }
         return;
     }

@@ -176,7 +176,7 @@ impl PdlBody {
     /// twist, shrunk so that the pressure drops by the threshold (zero below it).
     pub fn twist(&self, w: &Vec6, rate: f64, threshold_kpa: f64) -> Vec6 {
         let p = self.pressure_kpa(w);
-        if !(p > threshold_kpa) {
+        if p.is_nan() || p <= threshold_kpa {
             return [0.0; 6];
         }
         let scale = rate * (1.0 - threshold_kpa / p);

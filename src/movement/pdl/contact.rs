@@ -1,7 +1,7 @@
 //! Contact forces between touching teeth, solved for all contacts of a step together: each
 //! contact pushes along its normal with a force λ ≥ 0, and the teeth's twists under their loads
-//! plus these forces must not close any contact (relative normal velocity ≥ the contact's `bias`), with λ = 0
-//! wherever a contact opens (complementarity).
+//! plus these forces must not close any contact (relative normal velocity ≥ the contact's
+//! `bias`), with λ = 0 wherever a contact opens (complementarity).
 //!
 //! Method: projected Gauss–Seidel on λ. The twists are the gradient of a convex function of
 //! the wrenches ([`super::body`]), so these conditions are the optimality conditions of a convex

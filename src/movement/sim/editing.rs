@@ -49,6 +49,18 @@ impl Simulation {
         method: Method,
         settings: MovementSettings,
     ) -> Result<Self, MovementError> {
+        Self::with_ligaments(d, shapes, method, settings, &[])
+    }
+
+    /// [`Simulation::new`], taking the ligaments of `known` teeth (same settings) instead of
+    /// computing them again for their shapes.
+    fn with_ligaments(
+        d: &Dentition,
+        shapes: Vec<(Fdi, CollisionShape)>,
+        method: Method,
+        settings: MovementSettings,
+        known: &[SimTooth],
+    ) -> Result<Self, MovementError> {
         settings.validate()?;
         let curves = [
             ArchCurve::new(&d.arch_forms[0]),
@@ -146,6 +158,12 @@ impl Simulation {
             elapsed_days: 0.0,
         };
         if settings.model == MovementModel::Pdl {
+            for t in &mut sim.teeth {
+                t.pdl = known
+                    .iter()
+                    .find(|k| std::sync::Arc::ptr_eq(&k.shape.geometry, &t.shape.geometry))
+                    .and_then(|k| k.pdl.clone());
+            }
             sim.prepare_pdl()?;
         }
         Ok(sim)
@@ -295,7 +313,8 @@ impl Simulation {
                 t.extracted = true;
             }
         }
-        let mut next = Self::new(&edited, shapes, self.method, self.settings)?;
+        let mut next =
+            Self::with_ligaments(&edited, shapes, self.method, self.settings, &self.teeth)?;
         // (A restored tooth starts from the case: its initial pose, load and wire.)
         for t in &mut next.teeth {
             if let Some(i) = self.index_of(t.fdi) {

@@ -96,7 +96,8 @@ struct Unit {
 }
 
 impl Simulation {
-    /// Computes the ligament of every tooth that has none (once per distinct shape).
+    /// Computes the ligament of every tooth that has none, once per distinct shape (a simulation
+    /// remade for an extraction or restoration keeps the ligaments it had).
     ///
     /// # Errors
     /// [`MovementError::Pdl`] naming the tooth whose root cannot carry a ligament.
