@@ -35,6 +35,9 @@ enum Command {
     ExportCase(cli::export_case::ExportCaseArgs),
     /// Build each tooth's sphere tree and report its fit (the paper's relative outside volume).
     Trees(cli::trees::TreesArgs),
+    /// Where the arches meet: contacts, areas, the incisor gap; `--settle` closes the lower arch
+    /// onto the upper under a bite force until it is stable.
+    Occlusion(cli::occlusion::OcclusionArgs),
     /// Compare the periodontal-ligament model with published biomechanics (centres of
     /// resistance and rotation, moment-to-force ratios, displacement, rate of movement).
     Validate(cli::validate::ValidateArgs),
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::Trees(args) => cli::trees::run(args),
         Command::Bench(args) => cli::bench::run(args),
         Command::Validate(args) => cli::validate::run(args),
+        Command::Occlusion(args) => cli::occlusion::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

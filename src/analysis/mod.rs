@@ -7,6 +7,8 @@
 //! and [`report`] (`orthosim report`: every case under every method, to JSON, CSV, plots and HTML).
 
 pub mod biomechanics;
+pub mod bite;
+pub mod excursion;
 pub mod inspect;
 pub mod measures;
 pub mod occlusion;
@@ -20,6 +22,8 @@ use crate::{
 };
 
 pub use biomechanics::{Validation, ValidationRow, validate};
+pub use bite::{Bite, BiteContact, bite};
+pub use excursion::{Excursion, ExcursionKind, excursion};
 pub use inspect::{InspectReport, inspect};
 pub use occlusion::{MeasuredOcclusion, measure_occlusion};
 pub use report::{ALL_CASES, ReportOptions, Summary, run_report};

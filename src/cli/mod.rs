@@ -9,6 +9,7 @@ pub mod cases;
 pub mod choice;
 pub mod export_case;
 pub mod inspect;
+pub mod occlusion;
 pub mod report;
 pub mod screenshot;
 pub mod simulate;

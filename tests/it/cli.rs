@@ -452,6 +452,33 @@ fn simulate_takes_either_model_and_validate_prints_its_rows() {
 }
 
 #[test]
+fn occlusion_reports_the_settled_bite_with_the_contract_keys() {
+    let v = json_of(&["occlusion", "--settle", "--opening", "2", "--json"]);
+    for key in [
+        "case",
+        "stable",
+        "max_penetration_mm",
+        "incisor_gap_mm",
+        "contact_teeth",
+        "contacts",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}: {v}");
+    }
+    assert_eq!(v["case"], "normal");
+    assert_eq!(v["stable"], true, "{v}");
+    assert!(v["contact_teeth"]["left"].as_u64().unwrap() >= 1);
+    assert!(v["contact_teeth"]["right"].as_u64().unwrap() >= 1);
+    for c in v["contacts"].as_array().unwrap() {
+        for key in ["upper", "lower", "area_mm2", "min_gap_mm"] {
+            assert!(c.get(key).is_some(), "{c}");
+        }
+    }
+    let out = orthosim(&["occlusion", "--opening", "9"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("0 to 5 mm"));
+}
+
+#[test]
 fn simulate_refuses_unknown_cases_and_bad_options_in_one_line() {
     let out = orthosim(&["simulate", "--case", "nosuch"]);
     assert!(!out.status.success());

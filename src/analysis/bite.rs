@@ -1,0 +1,463 @@
+//! The bite: the lower arch closed onto the upper as one rigid body under a bite force, until it is
+//! stable (`orthosim occlusion --settle`).
+//!
+//! Quasi-static settle. The lower arch rises along the occlusal direction (+y) under a bite force
+//! whose line passes through the centroid of its crown centres. Each iteration measures every
+//! opposing pair whose boxes come near with the exact mesh distance; pairs within
+//! [`CONTACT_MM`] are contacts, each pushing along its normal (from the upper tooth's closest
+//! point to the lower's). The lower arch's motion is the bite force's, less what the contacts
+//! take (the contact solve of the PDL model on two bodies: the upper arch fixed, the lower with a
+//! mobility of 1 mm per N in translation and 1/R² in rotation, R = [`TURN_RADIUS_MM`]). It moves
+//! by conservative advancement: a step never longer than the smallest gap of the pairs not in
+//! contact, less [`TARGET_GAP_MM`], divided by the fastest speed any point of the arch can have;
+//! pairs in contact are checked afterwards and a step that brings any pair closer than
+//! [`TARGET_GAP_MM`] / 2 is halved. So the arches never interpenetrate (the exact stage's
+//! guarantee, tested). The bite is stable when the contacts take the whole force (the motion
+//! left is under [`STILL_MM`] per unit step): the line of the bite force then lies inside the
+//! contacts' support.
+//!
+//! Why a bite cannot become stable is said: the arches do not meet within the travel, or the
+//! lower arch keeps sliding off its contacts after [`MAX_ITERATIONS`].
+
+use glam::{DMat3, DVec3, Vec3};
+use serde::Serialize;
+
+use super::measures::{Posed, occlusal_contacts};
+use crate::{
+    geometry::{Mat6, MeshRef, Pose, halves, mesh_separation, vec6},
+    movement::pdl::{ContactRow, PdlBody, SolveParams, solve_contacts},
+    teeth::{Arch, Fdi, ToothKind},
+};
+
+/// Pairs this close (mm) are in contact.
+pub const CONTACT_MM: f32 = 0.02;
+/// Gap (mm) the advancement aims at before contacts take the force.
+pub const TARGET_GAP_MM: f32 = 0.005;
+/// Radius (mm) turning the lower arch's rotations into millimetres (about the arch's size).
+pub const TURN_RADIUS_MM: f64 = 25.0;
+/// Motion per unit step (mm) below which the bite is stable.
+pub const STILL_MM: f64 = 1e-4;
+/// Most iterations of a settle.
+pub const MAX_ITERATIONS: usize = 400;
+/// Surface within this distance (mm) of the opposing tooth counts towards a contact's area.
+pub const AREA_TOLERANCE_MM: f32 = 0.05;
+
+/// One opposing pair in the bite.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BiteContact {
+    /// Upper tooth.
+    pub upper: Fdi,
+    /// Lower tooth.
+    pub lower: Fdi,
+    /// Upper tooth's surface within 0.05 mm of the lower tooth (mm²).
+    pub area_mm2: f32,
+    /// Exact gap (mm; negative: penetration).
+    pub min_gap_mm: f32,
+}
+
+/// Contacting teeth per side (upper teeth with a contact).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct SideCounts {
+    /// The patient's left (quadrant 2).
+    pub left: usize,
+    /// The patient's right (quadrant 1).
+    pub right: usize,
+}
+
+/// The bite of a case.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Bite {
+    /// Case name.
+    pub case: String,
+    /// Whether the contacts hold the bite force (see the module doc).
+    pub stable: bool,
+    /// Why not, when not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why: Option<String>,
+    /// Deepest exact penetration between the arches (mm, 0 when none).
+    pub max_penetration_mm: f32,
+    /// Least gap between the upper and lower incisors (mm).
+    pub incisor_gap_mm: f32,
+    /// Contacting upper teeth per side.
+    pub contact_teeth: SideCounts,
+    /// Pairs in contact (within 0.05 mm).
+    pub contacts: Vec<BiteContact>,
+    /// How far the settle moved the lower arch: travel of its crown centroid (mm) and turn
+    /// (degrees); zero without a settle.
+    pub lower_travel_mm: f32,
+    /// Turn of the lower arch (degrees).
+    pub lower_turn_deg: f32,
+    /// Iterations of the settle.
+    pub iterations: usize,
+    /// Where the lower arch ended, relative to where the case placed it.
+    #[serde(skip)]
+    pub lower_pose: Pose,
+    /// The jaw's excursion from this bite, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub excursion: Option<super::excursion::Excursion>,
+}
+
+fn upper(t: &Posed) -> bool {
+    t.fdi.arch() == Arch::Upper
+}
+
+/// Exact separations of the opposing pairs whose boxes come within `margin`, with the lower
+/// arch moved by `moved` (applied to every lower tooth's pose).
+pub(super) fn separations(
+    teeth: &[Posed],
+    moved: &Pose,
+    margin: f32,
+) -> Vec<(usize, usize, crate::geometry::MeshSeparation)> {
+    let pose = |t: &Posed| {
+        if upper(t) { t.pose } else { moved.mul(&t.pose) }
+    };
+    let boxes: Vec<_> = teeth
+        .iter()
+        .map(|t| {
+            let p = pose(t);
+            t.geometry
+                .mesh
+                .aabb()
+                .transformed(&glam::Mat3::from_quat(p.rotation), p.translation)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (i, u) in teeth.iter().enumerate().filter(|(_, t)| upper(t)) {
+        for (j, l) in teeth.iter().enumerate().filter(|(_, t)| !upper(t)) {
+            let (a, b) = (&boxes[i], &boxes[j]);
+            let m = Vec3::splat(margin);
+            if !((a.min - m).cmple(b.max).all() && (b.min - m).cmple(a.max).all()) {
+                continue;
+            }
+            let s = mesh_separation(
+                MeshRef {
+                    mesh: &u.geometry.mesh,
+                    bvh: &u.geometry.bvh,
+                },
+                &pose(u),
+                MeshRef {
+                    mesh: &l.geometry.mesh,
+                    bvh: &l.geometry.bvh,
+                },
+                &pose(l),
+            );
+            out.push((i, j, s));
+        }
+    }
+    out
+}
+
+/// The opposing pairs a settle may bring together, each with a lower bound on its gap: measured
+/// exactly when it may be near, otherwise its last measure less how far any lower point has
+/// moved since (a conservative bound, so a pair left unmeasured cannot be in contact).
+struct Tracker<'a, 'b> {
+    teeth: &'b [Posed<'a>],
+    pairs: Vec<(usize, usize)>,
+    bound: Vec<f32>,
+    last: Vec<Option<crate::geometry::MeshSeparation>>,
+}
+
+impl<'a, 'b> Tracker<'a, 'b> {
+    /// Pairs whose boxes come within `margin` at `moved`, all measured.
+    fn new(teeth: &'b [Posed<'a>], moved: &Pose, margin: f32) -> Self {
+        let seps = separations(teeth, moved, margin);
+        Self {
+            teeth,
+            pairs: seps.iter().map(|(i, j, _)| (*i, *j)).collect(),
+            bound: seps.iter().map(|(_, _, s)| signed(s)).collect(),
+            last: seps.into_iter().map(|(_, _, s)| Some(s)).collect(),
+        }
+    }
+
+    fn measure(&self, k: usize, moved: &Pose) -> crate::geometry::MeshSeparation {
+        let (u, l) = (&self.teeth[self.pairs[k].0], &self.teeth[self.pairs[k].1]);
+        mesh_separation(
+            u.geometry.mesh_ref(),
+            &u.pose,
+            l.geometry.mesh_ref(),
+            &moved.mul(&l.pose),
+        )
+    }
+
+    /// Measures every pair whose bound is `near` or less.
+    fn refresh(&mut self, moved: &Pose, near: f32) {
+        for k in 0..self.pairs.len() {
+            if self.bound[k] <= near {
+                let s = self.measure(k, moved);
+                self.bound[k] = signed(&s);
+                self.last[k] = Some(s);
+            }
+        }
+    }
+
+    /// Tries `next`, reached with no lower point moving more than `delta`: measures the pairs
+    /// that could come near; true (and the bounds updated) when none comes closer than `floor`
+    /// (or than it already was, if closer).
+    fn try_step(&mut self, next: &Pose, delta: f32, floor: f32) -> bool {
+        let mut measured = Vec::new();
+        for k in 0..self.pairs.len() {
+            if self.bound[k] - delta <= 2.0 * CONTACT_MM {
+                let s = self.measure(k, next);
+                // A pair already closer than the floor may not get closer still.
+                if signed(&s) < floor.min(self.bound[k] - 1e-6) {
+                    return false;
+                }
+                measured.push((k, s));
+            }
+        }
+        for b in &mut self.bound {
+            *b -= delta;
+        }
+        for l in &mut self.last {
+            *l = None;
+        }
+        for (k, s) in measured {
+            self.bound[k] = signed(&s);
+            self.last[k] = Some(s);
+        }
+        true
+    }
+}
+
+pub(super) fn signed(s: &crate::geometry::MeshSeparation) -> f32 {
+    if s.penetration > 0.0 || s.distance <= 0.0 {
+        -s.penetration
+    } else {
+        s.distance
+    }
+}
+
+/// The bite of `teeth` as they stand (`settle` false) or with the lower arch closed onto the
+/// upper from `opening_mm` apart (see the module doc).
+pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite {
+    let lower: Vec<&Posed> = teeth.iter().filter(|t| !upper(t)).collect();
+    let centre = lower
+        .iter()
+        .map(|t| t.pose.transform_point(t.geometry.frame.crown_centre))
+        .sum::<Vec3>()
+        / lower.len().max(1) as f32;
+    // Farthest a lower-arch point lies from the centre: bounds a point's speed under a turn.
+    let reach = lower
+        .iter()
+        .flat_map(|t| {
+            t.geometry
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| t.pose.transform_point(*v).distance(centre))
+        })
+        .fold(0.0f32, f32::max) as f64;
+    let mut moved = Pose::from_translation(Vec3::new(0.0, -opening_mm.max(0.0), 0.0));
+    if !settle {
+        moved = Pose::IDENTITY;
+    }
+    let mut iterations = 0;
+    let mut why = None;
+    let mut stable = false;
+    let mobility = {
+        let mut m = Mat6::identity();
+        for k in 3..6 {
+            m.0[k][k] = 1.0 / (TURN_RADIUS_MM * TURN_RADIUS_MM);
+        }
+        m
+    };
+    let params = SolveParams {
+        rate: 1.0,
+        threshold_kpa: 0.0,
+        tolerance: 1e-12,
+        max_sweeps: 2_000,
+    };
+    let travel_limit = opening_mm.max(0.0) + 10.0;
+    let mut pairs = Tracker::new(teeth, &moved, opening_mm.max(0.0) + 3.0);
+    loop {
+        pairs.refresh(&moved, 2.0 * CONTACT_MM);
+        let c = moved.transform_point(centre).as_dvec3();
+        let contacts: Vec<ContactRow> = pairs
+            .last
+            .iter()
+            .flatten()
+            .filter(|s| signed(s) <= CONTACT_MM)
+            .filter_map(|s| {
+                let n = (s.point_b - s.point_a).as_dvec3().try_normalize()?;
+                Some(ContactRow {
+                    a: 0,
+                    b: 1,
+                    point: ((s.point_a + s.point_b) * 0.5).as_dvec3(),
+                    normal: n,
+                    bias: 0.0,
+                })
+            })
+            .collect();
+        let bodies = [
+            PdlBody {
+                centre: DVec3::ZERO,
+                compliance: Mat6::ZERO,
+                area: 1.0,
+                mean_spring: 1.0,
+                applied: [0.0; 6],
+            },
+            PdlBody {
+                centre: c,
+                compliance: mobility,
+                area: 1.0,
+                mean_spring: 1.0,
+                applied: vec6(DVec3::Y, DVec3::ZERO),
+            },
+        ];
+        let solve = solve_contacts(&bodies, &contacts, None, &params);
+        let (u, w) = halves(&solve.twists[1]);
+        let speed = u.length() + w.length() * reach;
+        if !contacts.is_empty() && speed < STILL_MM {
+            stable = true;
+            break;
+        }
+        if !settle {
+            why = Some(if contacts.is_empty() {
+                "the arches do not touch".to_owned()
+            } else {
+                "the contacts do not hold the bite force: the lower arch would slide or tilt"
+                    .to_owned()
+            });
+            break;
+        }
+        if iterations >= MAX_ITERATIONS {
+            why = Some(format!(
+                "the lower arch still slides after {MAX_ITERATIONS} steps ({} contacts)",
+                contacts.len()
+            ));
+            break;
+        }
+        iterations += 1;
+        // Conservative advancement against the pairs not in contact; the rest checked after.
+        let free_gap = pairs
+            .bound
+            .iter()
+            .copied()
+            .filter(|g| *g > CONTACT_MM)
+            .fold(f32::INFINITY, f32::min);
+        let mut step = if free_gap.is_finite() {
+            ((free_gap - TARGET_GAP_MM) as f64 / speed).max(0.0)
+        } else {
+            1.0 / speed
+        };
+        // Sliding on contacts: small steps, at most 0.05 mm at the fastest point.
+        if !contacts.is_empty() {
+            step = step.min(0.05 / speed);
+        }
+        let mut accepted = false;
+        for _ in 0..30 {
+            let turn =
+                DMat3::from_axis_angle(w.try_normalize().unwrap_or(DVec3::Y), w.length() * step);
+            let q = glam::DQuat::from_mat3(&turn).as_quat();
+            let delta = Pose::new(q, (c + u * step - turn * c).as_vec3());
+            let next = delta.mul(&moved);
+            if pairs.try_step(&next, (speed * step) as f32, TARGET_GAP_MM * 0.5) {
+                moved = next;
+                accepted = true;
+                break;
+            }
+            step *= 0.5;
+        }
+        let risen = moved.translation.y + opening_mm.max(0.0);
+        if !accepted || step * speed < 1e-7 {
+            why = Some(
+                "the lower arch is wedged: no step along the bite force keeps the arches apart"
+                    .to_owned(),
+            );
+            break;
+        }
+        if contacts.is_empty() && risen > travel_limit {
+            why = Some(format!(
+                "the arches do not meet within {travel_limit:.0} mm of closing"
+            ));
+            break;
+        }
+    }
+    let posed: Vec<Posed> = teeth
+        .iter()
+        .map(|t| Posed {
+            fdi: t.fdi,
+            geometry: t.geometry,
+            pose: if upper(t) { t.pose } else { moved.mul(&t.pose) },
+        })
+        .collect();
+    let seps = separations(teeth, &moved, AREA_TOLERANCE_MM);
+    let mut contacts = Vec::new();
+    let mut max_penetration = 0.0f32;
+    let mut incisor_gap = f32::INFINITY;
+    let incisor = |f: Fdi| {
+        matches!(
+            f.kind(),
+            ToothKind::CentralIncisor | ToothKind::LateralIncisor
+        )
+    };
+    for (i, j, s) in &seps {
+        let gap = signed(s);
+        max_penetration = max_penetration.max(-gap);
+        let (u, l) = (&posed[*i], &posed[*j]);
+        if incisor(u.fdi) && incisor(l.fdi) {
+            incisor_gap = incisor_gap.min(gap);
+        }
+        if gap <= AREA_TOLERANCE_MM {
+            let pair = [*u, *l];
+            let area = occlusal_contacts(&pair, AREA_TOLERANCE_MM)
+                .first()
+                .map_or(0.0, |c| c.area_mm2);
+            contacts.push(BiteContact {
+                upper: u.fdi,
+                lower: l.fdi,
+                area_mm2: area,
+                min_gap_mm: gap,
+            });
+        }
+    }
+    if !incisor_gap.is_finite() {
+        // Incisors too far apart for their boxes to meet: measure them directly.
+        for u in posed.iter().filter(|t| upper(t) && incisor(t.fdi)) {
+            for l in posed.iter().filter(|t| !upper(t) && incisor(t.fdi)) {
+                let s = mesh_separation(
+                    u.geometry.mesh_ref(),
+                    &u.pose,
+                    l.geometry.mesh_ref(),
+                    &l.pose,
+                );
+                incisor_gap = incisor_gap.min(signed(&s));
+            }
+        }
+    }
+    let mut side = SideCounts::default();
+    let mut counted: Vec<Fdi> = Vec::new();
+    for c in &contacts {
+        if counted.contains(&c.upper) {
+            continue;
+        }
+        counted.push(c.upper);
+        if c.upper.quadrant() == 2 {
+            side.left += 1;
+        } else {
+            side.right += 1;
+        }
+    }
+    let angle = 2.0 * moved.rotation.w.abs().min(1.0).acos();
+    let shift = if settle {
+        moved
+            .transform_point(centre)
+            .distance(centre + Vec3::new(0.0, -opening_mm.max(0.0), 0.0))
+    } else {
+        0.0
+    };
+    Bite {
+        case: case.to_owned(),
+        stable,
+        why,
+        max_penetration_mm: max_penetration,
+        incisor_gap_mm: incisor_gap,
+        contact_teeth: side,
+        contacts,
+        lower_travel_mm: shift,
+        lower_turn_deg: angle.to_degrees(),
+        iterations,
+        lower_pose: moved,
+        excursion: None,
+    }
+}

@@ -1,0 +1,259 @@
+//! The jaw's excursions from a bite: protrusion and right and left laterals in 0.5 mm steps, with
+//! the teeth that guide the lower arch and the contacts that interfere.
+//!
+//! Hinge-and-slide condyles: the condyles sit [`CONDYLE_HALF_WIDTH_MM`] either side of the
+//! midline, [`CONDYLE_BEHIND_MM`] behind the frame's origin and [`CONDYLE_ABOVE_MM`] above the
+//! occlusal plane. In protrusion by h both slide forward h and down h·tan(θ), θ =
+//! [`CONDYLAR_GUIDANCE_DEG`]; in a lateral by h the lower arch shifts h sideways, the working
+//! condyle (the side the jaw moves to) turns in place and the other slides down h·tan(θ). At each
+//! step the lower arch then closes about the axis through the condyles until its teeth meet the
+//! upper arch (conservative advancement on the closing angle with the exact mesh distance, so the
+//! arches never interpenetrate).
+//!
+//! Guidance at each step (contacts within [`super::bite::AREA_TOLERANCE_MM`]): `anterior` when
+//! only incisors and canines touch, `canine` when on the working side only the canine touches,
+//! `group function` when premolars or molars of the working side touch too, `none` when nothing
+//! touches. Interferences: posterior contacts in protrusion, non-working-side contacts in
+//! laterals.
+
+use glam::{Quat, Vec3};
+use serde::Serialize;
+
+use super::{
+    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, separations, signed},
+    measures::Posed,
+};
+use crate::{
+    geometry::Pose,
+    teeth::{Fdi, ToothKind},
+};
+
+/// Half the distance between the condyles (mm).
+pub const CONDYLE_HALF_WIDTH_MM: f32 = 50.0;
+/// How far behind the frame's origin the condyles sit (mm).
+pub const CONDYLE_BEHIND_MM: f32 = 75.0;
+/// How far above the occlusal plane the condyles sit (mm).
+pub const CONDYLE_ABOVE_MM: f32 = 25.0;
+/// Slope of the condyles' path, below the horizontal (degrees).
+pub const CONDYLAR_GUIDANCE_DEG: f32 = 35.0;
+/// Step of the excursion (mm).
+pub const STEP_MM: f32 = 0.5;
+/// Longest excursion (mm).
+pub const MAX_MM: f32 = 6.0;
+
+/// Which way the jaw moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ExcursionKind {
+    /// Forwards.
+    Protrusive,
+    /// To the patient's right.
+    Right,
+    /// To the patient's left.
+    Left,
+}
+
+impl ExcursionKind {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Protrusive => "protrusive",
+            Self::Right => "right",
+            Self::Left => "left",
+        }
+    }
+}
+
+/// One step of an excursion.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ExcursionStep {
+    /// How far the jaw has moved (mm).
+    pub mm: f32,
+    /// Opposing pairs in contact, [upper, lower].
+    pub contacts: Vec<[Fdi; 2]>,
+    /// `anterior`, `canine`, `group function` or `none`.
+    pub guidance: &'static str,
+    /// Pairs that interfere, [upper, lower].
+    pub interferences: Vec<[Fdi; 2]>,
+    /// Least gap between the arches (mm; negative: penetration).
+    pub min_gap_mm: f32,
+    /// How far the lower arch has opened at the incisors since the bite (mm).
+    pub opening_mm: f32,
+}
+
+/// An excursion.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Excursion {
+    /// Which.
+    pub kind: ExcursionKind,
+    /// Its steps, from 0.5 mm to `mm`.
+    pub steps: Vec<ExcursionStep>,
+}
+
+fn side_of(f: Fdi) -> i32 {
+    // +1: the patient's left (quadrants 2 and 3), −1: the right.
+    if matches!(f.quadrant(), 2 | 3) { 1 } else { -1 }
+}
+
+fn anterior(f: Fdi) -> bool {
+    matches!(
+        f.kind(),
+        ToothKind::CentralIncisor | ToothKind::LateralIncisor | ToothKind::Canine
+    )
+}
+
+/// The excursion `kind` up to `mm` (at most 6) from the bite where the lower arch stands at
+/// `bite` (relative to where the case placed it).
+pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> Excursion {
+    let tan = CONDYLAR_GUIDANCE_DEG.to_radians().tan();
+    let condyle = |s: f32| {
+        Vec3::new(
+            s * CONDYLE_HALF_WIDTH_MM,
+            CONDYLE_ABOVE_MM,
+            -CONDYLE_BEHIND_MM,
+        )
+    };
+    let incisal = Vec3::new(0.0, 0.0, 20.0);
+    let lower = |t: &Posed| t.fdi.arch() == crate::teeth::Arch::Lower;
+    // Farthest a lower tooth point lies from the hinge: bounds its speed per radian.
+    let reach = teeth
+        .iter()
+        .filter(|t| lower(t))
+        .flat_map(|t| {
+            t.geometry
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| bite.mul(&t.pose).transform_point(*v))
+        })
+        .map(|p| p.distance(condyle(0.0)) + CONDYLE_HALF_WIDTH_MM)
+        .fold(0.0f32, f32::max);
+    let count = ((mm.clamp(0.0, MAX_MM) / STEP_MM) + 1e-3).floor() as usize;
+    let mut steps = Vec::new();
+    let mut angle = 0.0f32;
+    for k in 1..=count {
+        let h = k as f32 * STEP_MM;
+        // The slide: the arch's placement before it closes, and the condyles after it.
+        let (slide, left, right) = match kind {
+            ExcursionKind::Protrusive => {
+                let d = Vec3::new(0.0, -h * tan, h);
+                (
+                    Pose::from_translation(d),
+                    condyle(1.0) + d,
+                    condyle(-1.0) + d,
+                )
+            }
+            ExcursionKind::Right | ExcursionKind::Left => {
+                let s = if kind == ExcursionKind::Left {
+                    1.0
+                } else {
+                    -1.0
+                };
+                // The working condyle (side s) stays; the other drops and the arch tilts about
+                // the anteroposterior line through the working condyle, then shifts sideways.
+                let working = condyle(s);
+                let drop = h * tan;
+                let tilt = Quat::from_rotation_z(s * (drop / (2.0 * CONDYLE_HALF_WIDTH_MM)).atan());
+                let turn = Pose::new(tilt, working - tilt * working);
+                let shift = Pose::from_translation(Vec3::new(s * h, 0.0, 0.0));
+                let slide = shift.mul(&turn);
+                (
+                    slide,
+                    slide.transform_point(condyle(1.0)),
+                    slide.transform_point(condyle(-1.0)),
+                )
+            }
+        };
+        let axis = (left - right).normalize();
+        // Closing turns the front of the arch up: about +x through the condyles.
+        let close = |phi: f32| {
+            let q = Quat::from_axis_angle(axis, -phi);
+            Pose::new(q, right - q * right).mul(&slide).mul(bite)
+        };
+        // Start open by 3° and close, never past the last step's angle by more than 3°.
+        let mut phi = angle - 3f32.to_radians();
+        let mut seps = separations(teeth, &close(phi), 1.0);
+        let least = |seps: &[(usize, usize, crate::geometry::MeshSeparation)]| {
+            seps.iter()
+                .map(|(_, _, s)| signed(s))
+                .fold(f32::INFINITY, f32::min)
+        };
+        // Open further while the slide alone brings the teeth together.
+        while least(&seps) < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
+            phi -= 3f32.to_radians();
+            seps = separations(teeth, &close(phi), 1.0);
+        }
+        for _ in 0..200 {
+            let gap = seps
+                .iter()
+                .map(|(_, _, s)| signed(s))
+                .fold(f32::INFINITY, f32::min);
+            if gap <= 2.0 * TARGET_GAP_MM {
+                break;
+            }
+            // Pairs farther apart than the 1 mm margin are not measured: no point may move
+            // further than that in one advance.
+            let dphi = (gap.min(1.0) - TARGET_GAP_MM) / reach;
+            phi += dphi;
+            seps = separations(teeth, &close(phi), 1.0);
+            if phi > angle + 10f32.to_radians() {
+                break;
+            }
+        }
+        angle = phi;
+        let placed = close(phi);
+        let mut contacts = Vec::new();
+        for (i, j, s) in &seps {
+            if signed(s) <= AREA_TOLERANCE_MM {
+                contacts.push([teeth[*i].fdi, teeth[*j].fdi]);
+            }
+        }
+        contacts.sort();
+        let working = match kind {
+            ExcursionKind::Left => 1,
+            ExcursionKind::Right => -1,
+            ExcursionKind::Protrusive => 0,
+        };
+        let interferences: Vec<[Fdi; 2]> = contacts
+            .iter()
+            .copied()
+            .filter(|[u, l]| match kind {
+                ExcursionKind::Protrusive => !anterior(*u) || !anterior(*l),
+                _ => side_of(*u) != working && side_of(*l) != working,
+            })
+            .collect();
+        let guidance = if contacts.is_empty() {
+            "none"
+        } else if kind == ExcursionKind::Protrusive {
+            "anterior"
+        } else {
+            let on_working: Vec<&[Fdi; 2]> = contacts
+                .iter()
+                .filter(|[u, _]| side_of(*u) == working)
+                .collect();
+            if on_working
+                .iter()
+                .any(|[u, l]| !anterior(*u) || !anterior(*l))
+            {
+                "group function"
+            } else if on_working
+                .iter()
+                .any(|[u, _]| u.kind() == ToothKind::Canine)
+            {
+                "canine"
+            } else {
+                "anterior"
+            }
+        };
+        let front = |p: &Pose| p.transform_point(incisal);
+        steps.push(ExcursionStep {
+            min_gap_mm: least(&seps),
+            mm: h,
+            contacts,
+            guidance,
+            interferences,
+            opening_mm: front(bite).y - front(&placed).y,
+        });
+    }
+    Excursion { kind, steps }
+}

@@ -1,0 +1,101 @@
+//! The bite: the lower arch closed onto the upper under a bite force until stable, never
+//! interpenetrating; what `orthosim occlusion` reports.
+
+use orthosim::{
+    analysis::{bite, measures::Posed},
+    teeth::{Case, Dentition},
+};
+
+fn dentition(case: &str) -> Dentition {
+    Dentition::build(Case::resolve(case).unwrap()).unwrap()
+}
+
+#[test]
+fn the_normal_bite_settles_onto_both_sides_without_penetration() {
+    let d = dentition("normal");
+    let teeth = Posed::of_dentition(&d);
+    // As arranged the arches meet at a point: no stable bite.
+    let before = bite("normal", &teeth, false, 0.0);
+    assert!(!before.stable && before.why.is_some(), "{before:?}");
+    for opening in [0.0, 3.0] {
+        let b = bite("normal", &teeth, true, opening);
+        assert!(b.stable, "{opening} mm: {:?}", b.why);
+        assert!(b.why.is_none());
+        assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+        assert!(
+            b.contact_teeth.left >= 2 && b.contact_teeth.right >= 2,
+            "{b:?}"
+        );
+        assert!(b.contacts.len() > before.contacts.len(), "{b:?}");
+        assert!(
+            b.contacts
+                .iter()
+                .all(|c| c.min_gap_mm >= -0.01 && c.min_gap_mm <= 0.05)
+        );
+        assert!(
+            b.contacts.iter().map(|c| c.area_mm2).sum::<f32>() > 0.3,
+            "{b:?}"
+        );
+        // It closed from the opening: the lower arch rose by about the opening.
+        assert!(b.lower_travel_mm >= opening, "{b:?}");
+    }
+}
+
+#[test]
+fn a_bite_without_antagonists_says_why() {
+    let mut d = dentition("normal");
+    // No lower posterior teeth: the lower arch tilts on its incisors and never holds.
+    for t in &mut d.teeth {
+        if t.fdi.arch() == orthosim::teeth::Arch::Lower && t.fdi.kind().is_posterior() {
+            t.extracted = true;
+        }
+    }
+    let teeth = Posed::of_dentition(&d);
+    let b = bite("normal", &teeth, true, 2.0);
+    assert!(!b.stable, "{b:?}");
+    assert!(b.why.as_deref().is_some_and(|w| !w.is_empty()));
+    assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+}
+
+#[test]
+fn excursions_keep_contact_and_flag_guidance_and_interferences() {
+    use orthosim::analysis::{ExcursionKind, excursion};
+    let d = dentition("normal");
+    let teeth = Posed::of_dentition(&d);
+    let b = bite("normal", &teeth, true, 0.0);
+    assert!(b.stable);
+    for kind in [
+        ExcursionKind::Protrusive,
+        ExcursionKind::Right,
+        ExcursionKind::Left,
+    ] {
+        let e = excursion(&teeth, &b.lower_pose, kind, 6.0);
+        assert_eq!(e.steps.len(), 12, "{kind:?}");
+        for (k, s) in e.steps.iter().enumerate() {
+            assert!((s.mm - 0.5 * (k + 1) as f32).abs() < 1e-6);
+            // Sliding keeps contact, and never through the other arch.
+            assert!(!s.contacts.is_empty(), "{kind:?} {s:?}");
+            assert!(
+                s.min_gap_mm >= 0.0 && s.min_gap_mm <= 0.05,
+                "{kind:?} {s:?}"
+            );
+            assert!(["anterior", "canine", "group function"].contains(&s.guidance));
+            for pair in &s.interferences {
+                assert!(s.contacts.contains(pair));
+            }
+            let side = |f: orthosim::teeth::Fdi| if matches!(f.quadrant(), 2 | 3) { 1 } else { -1 };
+            for [u, l] in &s.contacts {
+                let flagged = s.interferences.contains(&[*u, *l]);
+                match kind {
+                    ExcursionKind::Protrusive => {
+                        assert_eq!(flagged, u.kind().is_posterior() || l.kind().is_posterior())
+                    }
+                    ExcursionKind::Right => assert_eq!(flagged, side(*u) == 1 && side(*l) == 1),
+                    ExcursionKind::Left => assert_eq!(flagged, side(*u) == -1 && side(*l) == -1),
+                }
+            }
+        }
+        // The front teeth guide the jaw open as it slides.
+        assert!(e.steps[3].opening_mm > 0.5, "{kind:?} {:?}", e.steps[3]);
+    }
+}
