@@ -11,6 +11,7 @@ pub mod bite;
 pub mod excursion;
 pub mod inspect;
 pub mod measures;
+pub mod occlusal_map;
 pub mod occlusion;
 pub mod plot;
 pub mod report;

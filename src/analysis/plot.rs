@@ -26,7 +26,7 @@ const COLOURS: [RGBColor; 4] = [
     RGBColor(27, 120, 55),
 ];
 
-fn font() -> &'static str {
+pub(super) fn font() -> &'static str {
     static DONE: OnceLock<()> = OnceLock::new();
     DONE.get_or_init(|| {
         // The font is a valid TrueType file bundled by the crate; failure would be a build error.

@@ -100,6 +100,8 @@ pub struct Summary {
     pub occlusion: BTreeMap<String, Vec<OcclusalContact>>,
     /// The PDL model beside published biomechanics (`orthosim validate`).
     pub biomechanics: super::Validation,
+    /// The built-in normal case's bite, settled (`orthosim occlusion --settle`).
+    pub bite: super::Bite,
 }
 
 /// A row of `distances.csv`.
@@ -128,10 +130,18 @@ pub fn run_report(
     })?;
     // Outputs never replace inputs: refuse before any work if a file to be written is a case file
     // being read.
-    let mut outputs: Vec<std::path::PathBuf> = ["summary.json", "distances.csv", "index.html"]
-        .iter()
-        .map(|n| out.join(n))
-        .collect();
+    let mut outputs: Vec<std::path::PathBuf> = [
+        "summary.json",
+        "distances.csv",
+        "index.html",
+        "occlusion_upper.svg",
+        "occlusion_lower.svg",
+        "occlusion_upper.png",
+        "occlusion_lower.png",
+    ]
+    .iter()
+    .map(|n| out.join(n))
+    .collect();
     let mut resolved = Vec::new();
     for case in &opts.cases {
         let loaded = Case::resolve(case)?;
@@ -307,6 +317,43 @@ pub fn run_report(
             .map_or(f32::NAN, |t| t.geometry.anatomy.mesiodistal)
     };
     let biomechanics = super::validate(&opts.settings, crate::teeth::ToothResolution::default())?;
+    progress("bite", total, total);
+    let normal_teeth = Posed::of_dentition(&normal);
+    let bite = super::bite("normal", &normal_teeth, true, 0.0);
+    let settled: Vec<Posed> = normal_teeth
+        .iter()
+        .map(|t| Posed {
+            pose: if t.fdi.arch() == crate::teeth::Arch::Lower {
+                bite.lower_pose.mul(&t.pose)
+            } else {
+                t.pose
+            },
+            ..*t
+        })
+        .collect();
+    let mut maps = Vec::new();
+    for (arch, file, title) in [
+        (
+            crate::teeth::Arch::Upper,
+            "occlusion_upper.svg",
+            "upper arch, settled bite",
+        ),
+        (
+            crate::teeth::Arch::Lower,
+            "occlusion_lower.svg",
+            "lower arch, settled bite",
+        ),
+    ] {
+        let svg = super::occlusal_map::occlusal_map_svg(&settled, arch, title)?;
+        write_atomic(&out.join(file), &svg)?;
+        super::occlusal_map::occlusal_map_png(
+            &out.join(file).with_extension("png"),
+            &settled,
+            arch,
+            title,
+        )?;
+        maps.push((title.to_owned(), svg));
+    }
     let summary = Summary {
         cases,
         tree_fit,
@@ -314,6 +361,7 @@ pub fn run_report(
         ipr,
         occlusion,
         biomechanics,
+        bite,
     };
     write_atomic(
         &out.join("summary.json"),
@@ -330,7 +378,7 @@ pub fn run_report(
         );
     }
     write_atomic(&out.join("distances.csv"), &csv)?;
-    write_atomic(&out.join("index.html"), html(&summary, &plots))?;
+    write_atomic(&out.join("index.html"), html(&summary, &plots, &maps))?;
     progress("done", total, total);
     Ok(summary)
 }
@@ -342,7 +390,7 @@ fn escape(s: &str) -> String {
 }
 
 /// The self-contained page: tables and the plots inlined as SVG (the files beside it are linked).
-fn html(s: &Summary, plots: &[(String, String)]) -> String {
+fn html(s: &Summary, plots: &[(String, String)], maps: &[(String, String)]) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
@@ -449,7 +497,36 @@ adjacent pair, one series per algorithm. <a href=\"{0}.png\">PNG</a> · \
             );
         }
     }
-    h.push_str("</table>\n<h2>Tooth movement beside published biomechanics (PDL model, <code>orthosim validate</code>)</h2>\n<table><tr><th class=\"l\">quantity</th><th>tooth</th><th>M/F mm</th><th>value</th><th>accepted</th><th class=\"l\">unit</th><th class=\"l\">source</th><th class=\"l\">inside</th></tr>\n");
+    let b = &s.bite;
+    let _ = write!(
+        h,
+        "</table>\n<h2>The bite (normal case, settled: <code>orthosim occlusion --settle</code>)</h2>\n<p>{}; contacting upper teeth right {}, left {}; incisor gap {:.3} mm; max penetration {:.4} mm.</p>\n<table><tr><th class=\"l\">pair</th><th>area mm²</th><th>gap mm</th></tr>\n",
+        if b.stable {
+            "stable".to_owned()
+        } else {
+            format!("not stable: {}", escape(b.why.as_deref().unwrap_or("")))
+        },
+        b.contact_teeth.right,
+        b.contact_teeth.left,
+        b.incisor_gap_mm,
+        b.max_penetration_mm
+    );
+    for c in &b.contacts {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}-{}</td><td>{:.3}</td><td>{:.4}</td></tr>",
+            c.upper, c.lower, c.area_mm2, c.min_gap_mm
+        );
+    }
+    h.push_str("</table>\n<p>Occlusal contact maps (red at contact, yellow, green, blue at 0.5 mm, grey beyond):</p>\n");
+    for ((title, svg), file) in maps.iter().zip(["occlusion_upper", "occlusion_lower"]) {
+        let _ = writeln!(
+            h,
+            "<figure>{svg}<figcaption>{} (<a href=\"{file}.png\">PNG</a>, <a href=\"{file}.svg\">SVG</a>)</figcaption></figure>",
+            escape(title)
+        );
+    }
+    h.push_str("<h2>Tooth movement beside published biomechanics (PDL model, <code>orthosim validate</code>)</h2>\n<table><tr><th class=\"l\">quantity</th><th>tooth</th><th>M/F mm</th><th>value</th><th>accepted</th><th class=\"l\">unit</th><th class=\"l\">source</th><th class=\"l\">inside</th></tr>\n");
     for r in &s.biomechanics.rows {
         let _ = writeln!(
             h,

@@ -512,15 +512,26 @@ fn report_writes_every_file_its_page_refers_to() {
             refs.push(part.split('"').next().unwrap().to_owned());
         }
     }
-    for f in ["summary.json", "distances.csv", "case3.svg", "case3.png"] {
+    for f in [
+        "summary.json",
+        "distances.csv",
+        "case3.svg",
+        "case3.png",
+        "occlusion_upper.png",
+        "occlusion_lower.png",
+        "occlusion_upper.svg",
+        "occlusion_lower.svg",
+    ] {
         assert!(refs.iter().any(|r| r == f), "index.html refers to {f}");
     }
     for r in &refs {
         let len = std::fs::metadata(dir.join(r)).map(|m| m.len()).unwrap_or(0);
         assert!(len > 0, "{r} missing or empty");
     }
-    let png = std::fs::read(dir.join("case3.png")).unwrap();
-    assert_eq!(&png[..4], b"\x89PNG");
+    for png in ["case3.png", "occlusion_upper.png", "occlusion_lower.png"] {
+        let png = std::fs::read(dir.join(png)).unwrap();
+        assert_eq!(&png[..4], b"\x89PNG");
+    }
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     for m in ["circles", "spheres", "continuous", "exact"] {
@@ -535,6 +546,12 @@ fn report_writes_every_file_its_page_refers_to() {
             .unwrap()
             <= 0.01
     );
+    assert_eq!(v["bite"]["stable"], true, "{}", v["bite"]);
+    assert_eq!(
+        v["biomechanics"]["rows"].as_array().map(|r| r.len()),
+        Some(16)
+    );
+    assert!(html.contains("The bite") && html.contains("biomechanics"));
     let fit = v["tree_fit"].as_array().unwrap();
     assert_eq!(fit.len(), 2, "octree and medial at depth 3");
     for row in fit {
