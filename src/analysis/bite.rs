@@ -150,16 +150,16 @@ pub(super) fn separations(
 /// The opposing pairs a settle may bring together, each with a lower bound on its gap: measured
 /// exactly when it may be near, otherwise its last measure less how far any lower point has
 /// moved since (a conservative bound, so a pair left unmeasured cannot be in contact).
-struct Tracker<'a, 'b> {
+pub(super) struct Tracker<'a, 'b> {
     teeth: &'b [Posed<'a>],
-    pairs: Vec<(usize, usize)>,
-    bound: Vec<f32>,
-    last: Vec<Option<crate::geometry::MeshSeparation>>,
+    pub(super) pairs: Vec<(usize, usize)>,
+    pub(super) bound: Vec<f32>,
+    pub(super) last: Vec<Option<crate::geometry::MeshSeparation>>,
 }
 
 impl<'a, 'b> Tracker<'a, 'b> {
     /// Pairs whose boxes come within `margin` at `moved`, all measured.
-    fn new(teeth: &'b [Posed<'a>], moved: &Pose, margin: f32) -> Self {
+    pub(super) fn new(teeth: &'b [Posed<'a>], moved: &Pose, margin: f32) -> Self {
         let seps = separations(teeth, moved, margin);
         Self {
             teeth,
@@ -180,7 +180,7 @@ impl<'a, 'b> Tracker<'a, 'b> {
     }
 
     /// Measures every pair whose bound is `near` or less.
-    fn refresh(&mut self, moved: &Pose, near: f32) {
+    pub(super) fn refresh(&mut self, moved: &Pose, near: f32) {
         for k in 0..self.pairs.len() {
             if self.bound[k] <= near {
                 let s = self.measure(k, moved);
@@ -188,6 +188,19 @@ impl<'a, 'b> Tracker<'a, 'b> {
                 self.last[k] = Some(s);
             }
         }
+    }
+
+    /// The lower arch moved with no point moving more than `delta`: every bound drops by it.
+    pub(super) fn advance(&mut self, delta: f32) {
+        for (b, l) in self.bound.iter_mut().zip(&mut self.last) {
+            *b -= delta;
+            *l = None;
+        }
+    }
+
+    /// The least bound.
+    pub(super) fn least(&self) -> f32 {
+        self.bound.iter().copied().fold(f32::INFINITY, f32::min)
     }
 
     /// Tries `next`, reached with no lower point moving more than `delta`: measures the pairs

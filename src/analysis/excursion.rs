@@ -20,7 +20,7 @@ use glam::{Quat, Vec3};
 use serde::Serialize;
 
 use super::{
-    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, separations, signed},
+    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, Tracker, signed},
     measures::Posed,
 };
 use crate::{
@@ -115,19 +115,18 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
     };
     let incisal = Vec3::new(0.0, 0.0, 20.0);
     let lower = |t: &Posed| t.fdi.arch() == crate::teeth::Arch::Lower;
-    // Farthest a lower tooth point lies from the hinge: bounds its speed per radian.
-    let reach = teeth
+    let lower_points: Vec<Vec3> = teeth
         .iter()
         .filter(|t| lower(t))
         .flat_map(|t| {
+            let pose = bite.mul(&t.pose);
             t.geometry
                 .mesh
                 .vertices
                 .iter()
-                .map(|v| bite.mul(&t.pose).transform_point(*v))
+                .map(move |v| pose.transform_point(*v))
         })
-        .map(|p| p.distance(condyle(0.0)) + CONDYLE_HALF_WIDTH_MM)
-        .fold(0.0f32, f32::max);
+        .collect();
     let count = ((mm.clamp(0.0, MAX_MM) / STEP_MM) + 1e-3).floor() as usize;
     let mut steps = Vec::new();
     let mut angle = 0.0f32;
@@ -170,44 +169,58 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
             let q = Quat::from_axis_angle(axis, -phi);
             Pose::new(q, right - q * right).mul(&slide).mul(bite)
         };
-        // Start open by 3° and close, never past the last step's angle by more than 3°.
-        let mut phi = angle - 3f32.to_radians();
-        let mut seps = separations(teeth, &close(phi), 1.0);
-        let least = |seps: &[(usize, usize, crate::geometry::MeshSeparation)]| {
-            seps.iter()
-                .map(|(_, _, s)| signed(s))
-                .fold(f32::INFINITY, f32::min)
-        };
-        // Open further while the slide alone brings the teeth together.
-        while least(&seps) < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
-            phi -= 3f32.to_radians();
-            seps = separations(teeth, &close(phi), 1.0);
+        // How far any lower point lies from the hinge axis (1 mm spare): bounds its speed per
+        // radian.
+        let reach = lower_points
+            .iter()
+            .map(|p| {
+                let q = slide.transform_point(*p) - right;
+                (q - axis * q.dot(axis)).length()
+            })
+            .fold(0.0f32, f32::max)
+            + 1.0;
+        // Start open by 1° and close; open further while the slide alone brings the teeth
+        // together.
+        let mut phi = angle - 1f32.to_radians();
+        let mut pairs = Tracker::new(teeth, &close(phi), 3.0);
+        while pairs.least() < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
+            phi -= 2f32.to_radians();
+            pairs = Tracker::new(teeth, &close(phi), 3.0);
         }
-        for _ in 0..200 {
-            let gap = seps
-                .iter()
-                .map(|(_, _, s)| signed(s))
-                .fold(f32::INFINITY, f32::min);
-            if gap <= 2.0 * TARGET_GAP_MM {
+        // Motion since the pairs were listed: past 2.5 mm a pair beyond the 3 mm margin could
+        // come near, so they are listed again.
+        let mut travelled = 0.0f32;
+        for _ in 0..400 {
+            if travelled > 2.5 {
+                pairs = Tracker::new(teeth, &close(phi), 3.0);
+                travelled = 0.0;
+            }
+            pairs.refresh(&close(phi), 0.5);
+            let gap = pairs.least();
+            if gap <= 2.0 * TARGET_GAP_MM || phi > angle + 10f32.to_radians() {
                 break;
             }
-            // Pairs farther apart than the 1 mm margin are not measured: no point may move
-            // further than that in one advance.
-            let dphi = (gap.min(1.0) - TARGET_GAP_MM) / reach;
+            let dphi = (gap.min(2.5 - travelled) - TARGET_GAP_MM).max(0.0) / reach;
             phi += dphi;
-            seps = separations(teeth, &close(phi), 1.0);
-            if phi > angle + 10f32.to_radians() {
-                break;
+            pairs.advance(dphi * reach);
+            travelled += dphi * reach;
+            if dphi == 0.0 {
+                travelled = 3.0;
             }
         }
+        pairs.refresh(&close(phi), AREA_TOLERANCE_MM);
         angle = phi;
         let placed = close(phi);
         let mut contacts = Vec::new();
-        for (i, j, s) in &seps {
-            if signed(s) <= AREA_TOLERANCE_MM {
-                contacts.push([teeth[*i].fdi, teeth[*j].fdi]);
+        for (k, s) in pairs.last.iter().enumerate() {
+            if let Some(s) = s
+                && signed(s) <= AREA_TOLERANCE_MM
+            {
+                let (i, j) = pairs.pairs[k];
+                contacts.push([teeth[i].fdi, teeth[j].fdi]);
             }
         }
+        let least_gap = pairs.least();
         contacts.sort();
         let working = match kind {
             ExcursionKind::Left => 1,
@@ -247,7 +260,7 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         };
         let front = |p: &Pose| p.transform_point(incisal);
         steps.push(ExcursionStep {
-            min_gap_mm: least(&seps),
+            min_gap_mm: least_gap,
             mm: h,
             contacts,
             guidance,

@@ -8,6 +8,7 @@
 
 pub mod biomechanics;
 pub mod bite;
+pub mod bite_bench;
 pub mod excursion;
 pub mod inspect;
 pub mod measures;

@@ -4,6 +4,7 @@
 use anyhow::Result;
 use clap::Args;
 use orthosim::{
+    analysis::bite_bench::{BiteBench, bite_bench},
     collision::bench::{self, MethodReport},
     movement::bench::{PdlBench, pdl_bench},
     teeth::{Case, Dentition},
@@ -98,6 +99,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         BenchResolution::Default => None,
     };
     let pdl = pdl_bench(vertices, 200)?;
+    let bite = bite_bench(vertices, 3)?;
     if progress {
         eprintln!();
     }
@@ -107,10 +109,12 @@ pub fn run(args: BenchArgs) -> Result<()> {
             #[serde(flatten)]
             report: &'a bench::BenchReport,
             pdl: &'a PdlBench,
+            bite: &'a BiteBench,
         }
         return print_json(&Output {
             report: &report,
             pdl: &pdl,
+            bite: &bite,
         });
     }
     let tree = args.trees.tree;
@@ -152,6 +156,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
             s.collision_us_per_step
         );
     }
+    println!(
+        "bite of the normal case ({} triangles per tooth, {} runs): measuring it {:.0}–{:.0} ms, settling it {:.0}–{:.0} ms, a 6 mm right excursion {:.0}–{:.0} ms",
+        bite.triangles_per_tooth,
+        bite.runs,
+        bite.measure_ms[0],
+        bite.measure_ms[1],
+        bite.settle_ms[0],
+        bite.settle_ms[1],
+        bite.excursion_ms[0],
+        bite.excursion_ms[1]
+    );
     Ok(())
 }
 
