@@ -77,6 +77,9 @@ pub struct ExcursionStep {
     pub interferences: Vec<[Fdi; 2]>,
     /// Least gap between the arches (mm; negative: penetration).
     pub min_gap_mm: f32,
+    /// Where the lower arch stands at this step, relative to where its teeth were given.
+    #[serde(skip)]
+    pub lower_pose: Pose,
     /// How far the lower arch has opened at the incisors since the bite (mm).
     pub opening_mm: f32,
 }
@@ -261,6 +264,7 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         let front = |p: &Pose| p.transform_point(incisal);
         steps.push(ExcursionStep {
             min_gap_mm: least_gap,
+            lower_pose: placed,
             mm: h,
             contacts,
             guidance,

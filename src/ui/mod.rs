@@ -20,10 +20,13 @@
 //!   tooth's mesial, buccal and occlusal axes. The selected teeth can also get a round or
 //!   rectangular wire, or be extracted and restored while the case runs (a refused restore shows
 //!   its reason).
+//! - **Bite** (`bite`, its own window): settle the lower arch onto the upper, play protrusion or
+//!   a lateral excursion with its guidance and interferences, the contact area per pair.
 //!
 //! The camera ignores the mouse while the pointer is over the panel: the plugin makes the view's
 //! [`CameraInputSystems`] run only when egui does not want the pointer.
 
+mod bite;
 mod case;
 mod collision;
 mod readouts;
@@ -59,9 +62,13 @@ impl Plugin for OrthoSimUiPlugin {
         }
         app.init_resource::<PanelState>()
             .init_resource::<teeth::LoadEditor>()
+            .init_resource::<bite::BiteView>()
             .configure_sets(Update, CameraInputSystems.run_if(pointer_free))
             .add_observer(teeth::click_tooth)
-            .add_systems(EguiPrimaryContextPass, (panel, teeth::loads_window))
+            .add_systems(
+                EguiPrimaryContextPass,
+                (panel, teeth::loads_window, bite::bite_window),
+            )
             .add_systems(Update, single_step);
     }
 }

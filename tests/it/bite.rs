@@ -99,3 +99,46 @@ fn excursions_keep_contact_and_flag_guidance_and_interferences() {
         assert!(e.steps[3].opening_mm > 0.5, "{kind:?} {:?}", e.steps[3]);
     }
 }
+
+#[test]
+fn a_settled_bite_placed_in_a_simulation_stays_there() {
+    use orthosim::{
+        collision::{Method, collision_shapes},
+        movement::{MovementSettings, Simulation, max_penetration},
+        sphere_tree::{TreeMethod, TreeSettings},
+        teeth::Arch,
+    };
+    let d = dentition("normal");
+    let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
+    let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+    let teeth: Vec<Posed> = sim
+        .teeth
+        .iter()
+        .map(|t| Posed {
+            fdi: t.fdi,
+            geometry: &t.shape.geometry,
+            pose: t.pose,
+        })
+        .collect();
+    let b = bite("normal", &teeth, true, 0.0);
+    assert!(b.stable);
+    let poses: Vec<_> = sim
+        .teeth
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.fdi.arch() == Arch::Lower)
+        .map(|(i, t)| (i, b.lower_pose.mul(&t.pose)))
+        .collect();
+    sim.place_teeth(&poses);
+    for (i, p) in &poses {
+        assert_eq!(sim.teeth[*i].pose, *p);
+    }
+    assert!(max_penetration(&sim) <= 0.01);
+    // Nothing is loaded: the settled teeth rest where they were put.
+    for _ in 0..5 {
+        assert!(sim.step().moved == 0);
+    }
+    for (i, p) in &poses {
+        assert_eq!(sim.teeth[*i].pose, *p);
+    }
+}

@@ -200,6 +200,21 @@ impl Simulation {
         Ok(())
     }
 
+    /// Moves teeth to new poses outside the simulation's own steps (the viewer's bite and
+    /// excursions): their motions are reset and the contacts between steps forgotten.
+    pub fn place_teeth(&mut self, poses: &[(usize, crate::geometry::Pose)]) {
+        for &(i, pose) in poses {
+            if i < self.teeth.len() && pose.is_finite() {
+                self.teeth[i].pose = pose;
+                self.teeth[i].arc = arc_of(&self.curves[row(self.teeth[i].fdi.arch())], &pose);
+                self.motions[i] = Motion::still(pose);
+            }
+        }
+        self.pdl.touching.clear();
+        self.pdl.forces.clear();
+        self.pdl.cache.clear();
+    }
+
     /// Sets a tooth's moment-to-force ratio at the bracket (mm; None: the wire decides).
     ///
     /// # Errors
