@@ -56,6 +56,18 @@ pub struct Posed<'a> {
 }
 
 impl<'a> Posed<'a> {
+    /// The teeth of a simulation where they stand now.
+    pub fn of_simulation(sim: &'a crate::movement::Simulation) -> Vec<Self> {
+        sim.teeth
+            .iter()
+            .map(|t| Posed {
+                fdi: t.fdi,
+                geometry: &t.shape.geometry,
+                pose: t.pose,
+            })
+            .collect()
+    }
+
     /// The visible teeth of a dentition as placed.
     pub fn of_dentition(d: &'a crate::teeth::Dentition) -> Vec<Self> {
         d.visible()

@@ -144,16 +144,7 @@ pub(super) fn bite_window(
             .filter(|(_, t)| t.fdi.arch() == Arch::Lower)
             .map(|(i, t)| (i, t.pose))
             .collect();
-        let teeth: Vec<Posed> = sim
-            .teeth
-            .iter()
-            .map(|t| Posed {
-                fdi: t.fdi,
-                geometry: &t.shape.geometry,
-                pose: t.pose,
-            })
-            .collect();
-        let b = bite("viewer", &teeth, true, 0.0);
+        let b = bite("viewer", &Posed::of_simulation(sim), true, 0.0);
         let lower = b.lower_pose;
         *view = BiteView {
             base,
@@ -164,20 +155,12 @@ pub(super) fn bite_window(
     }
     if let (Some(kind), Some(b), Some(sim)) = (start, view.bite.as_ref(), state.sim.as_ref()) {
         // The excursion from the settled bite, over the teeth where the bite was settled from.
-        let teeth: Vec<Posed> = sim
-            .teeth
-            .iter()
-            .enumerate()
-            .map(|(i, t)| Posed {
-                fdi: t.fdi,
-                geometry: &t.shape.geometry,
-                pose: view
-                    .base
-                    .iter()
-                    .find(|(k, _)| *k == i)
-                    .map_or(t.pose, |(_, p)| *p),
-            })
-            .collect();
+        let mut teeth = Posed::of_simulation(sim);
+        for (i, p) in &view.base {
+            if let Some(t) = teeth.get_mut(*i) {
+                t.pose = *p;
+            }
+        }
         let e = excursion(&teeth, &b.lower_pose, kind, 6.0);
         let poses = e.steps.iter().map(|s| s.lower_pose).collect();
         view.excursion = Some((e, poses));

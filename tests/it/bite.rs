@@ -111,16 +111,7 @@ fn a_settled_bite_placed_in_a_simulation_stays_there() {
     let d = dentition("normal");
     let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
     let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
-    let teeth: Vec<Posed> = sim
-        .teeth
-        .iter()
-        .map(|t| Posed {
-            fdi: t.fdi,
-            geometry: &t.shape.geometry,
-            pose: t.pose,
-        })
-        .collect();
-    let b = bite("normal", &teeth, true, 0.0);
+    let b = bite("normal", &Posed::of_simulation(&sim), true, 0.0);
     assert!(b.stable);
     let poses: Vec<_> = sim
         .teeth
