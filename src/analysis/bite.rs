@@ -164,7 +164,7 @@ impl<'a, 'b> Tracker<'a, 'b> {
         Self {
             teeth,
             pairs: seps.iter().map(|(i, j, _)| (*i, *j)).collect(),
-            bound: seps.iter().map(|(_, _, s)| signed(s)).collect(),
+            bound: seps.iter().map(|(_, _, s)| s.signed_gap()).collect(),
             last: seps.into_iter().map(|(_, _, s)| Some(s)).collect(),
         }
     }
@@ -184,7 +184,7 @@ impl<'a, 'b> Tracker<'a, 'b> {
         for k in 0..self.pairs.len() {
             if self.bound[k] <= near {
                 let s = self.measure(k, moved);
-                self.bound[k] = signed(&s);
+                self.bound[k] = s.signed_gap();
                 self.last[k] = Some(s);
             }
         }
@@ -212,7 +212,7 @@ impl<'a, 'b> Tracker<'a, 'b> {
             if self.bound[k] - delta <= 2.0 * CONTACT_MM {
                 let s = self.measure(k, next);
                 // A pair already closer than the floor may not get closer still.
-                if signed(&s) < floor.min(self.bound[k] - 1e-6) {
+                if s.signed_gap() < floor.min(self.bound[k] - 1e-6) {
                     return false;
                 }
                 measured.push((k, s));
@@ -225,18 +225,10 @@ impl<'a, 'b> Tracker<'a, 'b> {
             *l = None;
         }
         for (k, s) in measured {
-            self.bound[k] = signed(&s);
+            self.bound[k] = s.signed_gap();
             self.last[k] = Some(s);
         }
         true
-    }
-}
-
-pub(super) fn signed(s: &crate::geometry::MeshSeparation) -> f32 {
-    if s.penetration > 0.0 || s.distance <= 0.0 {
-        -s.penetration
-    } else {
-        s.distance
     }
 }
 
@@ -289,7 +281,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
             .last
             .iter()
             .flatten()
-            .filter(|s| signed(s) <= CONTACT_MM)
+            .filter(|s| s.signed_gap() <= CONTACT_MM)
             .filter_map(|s| {
                 let n = (s.point_b - s.point_a).as_dvec3().try_normalize()?;
                 Some(ContactRow {
@@ -405,7 +397,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         )
     };
     for (i, j, s) in &seps {
-        let gap = signed(s);
+        let gap = s.signed_gap();
         max_penetration = max_penetration.max(-gap);
         let (u, l) = (&posed[*i], &posed[*j]);
         if incisor(u.fdi) && incisor(l.fdi) {
@@ -434,7 +426,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
                     l.geometry.mesh_ref(),
                     &l.pose,
                 );
-                incisor_gap = incisor_gap.min(signed(&s));
+                incisor_gap = incisor_gap.min(s.signed_gap());
             }
         }
     }

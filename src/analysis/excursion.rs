@@ -20,7 +20,7 @@ use glam::{Quat, Vec3};
 use serde::Serialize;
 
 use super::{
-    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, Tracker, signed},
+    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, Tracker},
     measures::Posed,
 };
 use crate::{
@@ -217,7 +217,7 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         let mut contacts = Vec::new();
         for (k, s) in pairs.last.iter().enumerate() {
             if let Some(s) = s
-                && signed(s) <= AREA_TOLERANCE_MM
+                && s.signed_gap() <= AREA_TOLERANCE_MM
             {
                 let (i, j) = pairs.pairs[k];
                 contacts.push([teeth[i].fdi, teeth[j].fdi]);

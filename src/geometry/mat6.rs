@@ -44,6 +44,20 @@ impl Mat6 {
         m
     }
 
+    /// Matrix product `self · other`.
+    pub fn mul(&self, other: &Self) -> Self {
+        Self(std::array::from_fn(|r| {
+            std::array::from_fn(|c| (0..6).map(|k| self.0[r][k] * other.0[k][c]).sum())
+        }))
+    }
+
+    /// The transpose.
+    pub fn transpose(&self) -> Self {
+        Self(std::array::from_fn(|r| {
+            std::array::from_fn(|c| self.0[c][r])
+        }))
+    }
+
     /// Matrix times vector.
     pub fn mul_vec(&self, v: &Vec6) -> Vec6 {
         let mut out = [0.0; 6];
@@ -136,9 +150,8 @@ mod tests {
             assert!((u - v).abs() < 1e-12);
         }
         let inv = m.inverse().unwrap();
-        let id = Mat6(std::array::from_fn(|r| {
-            std::array::from_fn(|c| (0..6).map(|k| m.0[r][k] * inv.0[k][c]).sum())
-        }));
+        let id = m.mul(&inv);
+        assert_eq!(m.transpose().transpose(), m);
         for r in 0..6 {
             for c in 0..6 {
                 let want = if r == c { 1.0 } else { 0.0 };

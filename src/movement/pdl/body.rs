@@ -40,18 +40,7 @@ pub fn shifted(k: &Mat6, from: DVec3, to: DVec3) -> Mat6 {
             t.0[i][3 + j] = -v;
         }
     }
-    let kt = mul(k, &t);
-    mul(&transpose(&t), &kt)
-}
-
-fn mul(a: &Mat6, b: &Mat6) -> Mat6 {
-    Mat6(std::array::from_fn(|r| {
-        std::array::from_fn(|c| (0..6).map(|k| a.0[r][k] * b.0[k][c]).sum())
-    }))
-}
-
-fn transpose(a: &Mat6) -> Mat6 {
-    Mat6(std::array::from_fn(|r| std::array::from_fn(|c| a.0[c][r])))
+    t.transpose().mul(&k.mul(&t))
 }
 
 /// The compliance of stiffness `k` when the body may only move along `allowed` (orthonormal
@@ -155,18 +144,6 @@ pub struct PdlBody {
 }
 
 impl PdlBody {
-    /// A body from a tooth's ligament at a pose (rotation `r`, cres at `centre`) with the
-    /// effective compliance `compliance` (world) and the applied wrench.
-    pub fn new(pdl: &PdlStiffness, centre: DVec3, compliance: Mat6, applied: Vec6) -> Self {
-        Self {
-            centre,
-            compliance,
-            area: pdl.root_area_mm2,
-            mean_spring: pdl.mean_spring,
-            applied,
-        }
-    }
-
     /// Mean ligament pressure (kPa) under wrench `w` (see [`PdlStiffness::pressure_kpa`]).
     pub fn pressure_kpa(&self, w: &Vec6) -> f64 {
         PdlStiffness::pressure_kpa(&self.compliance, self.mean_spring, self.area, w)
@@ -207,7 +184,7 @@ mod tests {
                 *x = next() as f64;
             }
         }
-        mul(&transpose(&a), &a).add_scaled(&Mat6::identity(), 0.5)
+        a.transpose().mul(&a).add_scaled(&Mat6::identity(), 0.5)
     }
 
     #[test]

@@ -323,7 +323,8 @@ impl Simulation {
             });
             row_of.push(k);
         }
-        let bodies: Vec<PdlBody> = units.iter().map(|u| u.body.clone()).collect();
+        let (members, bodies): (Vec<Vec<usize>>, Vec<PdlBody>) =
+            units.into_iter().map(|u| (u.members, u.body)).unzip();
         let s = &self.settings.pdl;
         let params = SolveParams {
             rate: s.remodelling_per_day as f64 * s.step_days(),
@@ -361,22 +362,22 @@ impl Simulation {
         self.pdl.forces = forces;
         self.pdl.twists = vec![[0.0; 6]; n];
         self.pdl.wrenches = vec![[0.0; 6]; n];
-        for (u, unit) in units.iter().enumerate() {
-            for &i in &unit.members {
+        for (u, group) in members.iter().enumerate() {
+            for &i in group {
                 self.pdl.twists[i] = solve.twists[u];
                 self.pdl.wrenches[i] = solve.wrenches[u];
                 self.effective[i] = halves(&solve.wrenches[u]).0.as_vec3();
             }
         }
-        for (u, unit) in units.iter().enumerate() {
+        for (u, group) in members.iter().enumerate() {
             let (v, w) = halves(&solve.twists[u]);
             let d = Drive {
                 velocity: v.as_vec3(),
                 angular: w.as_vec3(),
-                pivot: unit.body.centre.as_vec3(),
+                pivot: bodies[u].centre.as_vec3(),
             };
             if !d.is_zero() {
-                self.move_rigid(&unit.members, d);
+                self.move_rigid(group, d);
             }
         }
     }
