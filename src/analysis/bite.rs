@@ -190,12 +190,9 @@ impl<'a, 'b> Tracker<'a, 'b> {
         }
     }
 
-    /// The lower arch moved with no point moving more than `delta`: every bound drops by it.
-    pub(super) fn advance(&mut self, delta: f32) {
-        for (b, l) in self.bound.iter_mut().zip(&mut self.last) {
-            *b -= delta;
-            *l = None;
-        }
+    /// The lower arch moved (the caller lowered the bounds): the last measures are stale.
+    pub(super) fn forget(&mut self) {
+        self.last.fill(None);
     }
 
     /// The least bound.

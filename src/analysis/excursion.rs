@@ -40,6 +40,10 @@ pub const CONDYLAR_GUIDANCE_DEG: f32 = 35.0;
 pub const STEP_MM: f32 = 0.5;
 /// Longest excursion (mm).
 pub const MAX_MM: f32 = 6.0;
+/// Opposing pairs whose boxes come this near (mm) are followed while the arch closes.
+const LIST_MARGIN_MM: f32 = 3.0;
+/// Closing travel (mm, at the farthest lower point) after which the pairs are listed again.
+const RELIST_MM: f32 = 2.5;
 
 /// Which way the jaw moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -118,18 +122,29 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
     };
     let incisal = Vec3::new(0.0, 0.0, 20.0);
     let lower = |t: &Posed| t.fdi.arch() == crate::teeth::Arch::Lower;
-    let lower_points: Vec<Vec3> = teeth
+    // Each lower tooth's vertices at the bite, and which of them each tooth is.
+    let lower_points: Vec<Vec<Vec3>> = teeth
         .iter()
         .filter(|t| lower(t))
-        .flat_map(|t| {
+        .map(|t| {
             let pose = bite.mul(&t.pose);
             t.geometry
                 .mesh
                 .vertices
                 .iter()
-                .map(move |v| pose.transform_point(*v))
+                .map(|v| pose.transform_point(*v))
+                .collect()
         })
         .collect();
+    let mut lower_of = vec![usize::MAX; teeth.len()];
+    for (k, (i, _)) in teeth
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| lower(t))
+        .enumerate()
+    {
+        lower_of[i] = k;
+    }
     let count = ((mm.clamp(0.0, MAX_MM) / STEP_MM) + 1e-3).floor() as usize;
     let mut steps = Vec::new();
     let mut angle = 0.0f32;
@@ -172,44 +187,60 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
             let q = Quat::from_axis_angle(axis, -phi);
             Pose::new(q, right - q * right).mul(&slide).mul(bite)
         };
-        // How far any lower point lies from the hinge axis (1 mm spare): bounds its speed per
-        // radian.
-        let reach = lower_points
+        // How far each lower tooth's points lie from the hinge axis (1 mm spare): bounds their
+        // speed per radian, so a pair's gap shrinks by at most its lower tooth's reach per radian
+        // of closing; `reach` is the largest, bounding every lower point.
+        let tooth_reach: Vec<f32> = lower_points
             .iter()
-            .map(|p| {
-                let q = slide.transform_point(*p) - right;
-                (q - axis * q.dot(axis)).length()
+            .map(|points| {
+                points
+                    .iter()
+                    .map(|p| {
+                        let q = slide.transform_point(*p) - right;
+                        (q - axis * q.dot(axis)).length()
+                    })
+                    .fold(0.0f32, f32::max)
+                    + 1.0
             })
-            .fold(0.0f32, f32::max)
-            + 1.0;
+            .collect();
+        let reach = tooth_reach.iter().copied().fold(0.0f32, f32::max);
         // Start open by 1° and close; open further while the slide alone brings the teeth
         // together.
         let mut phi = angle - 1f32.to_radians();
-        let mut pairs = Tracker::new(teeth, &close(phi), 3.0);
+        let mut pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
         while pairs.least() < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
             phi -= 2f32.to_radians();
-            pairs = Tracker::new(teeth, &close(phi), 3.0);
+            pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
         }
-        // Motion since the pairs were listed: past 2.5 mm a pair beyond the 3 mm margin could
-        // come near, so they are listed again.
+        // Motion since the pairs were listed: past RELIST_MM a pair beyond the margin could come
+        // near, so they are listed again.
         let mut travelled = 0.0f32;
         for _ in 0..400 {
-            if travelled > 2.5 {
-                pairs = Tracker::new(teeth, &close(phi), 3.0);
+            if travelled > RELIST_MM {
+                pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
                 travelled = 0.0;
             }
             pairs.refresh(&close(phi), 0.5);
-            let gap = pairs.least();
-            if gap <= 2.0 * TARGET_GAP_MM || phi > angle + 10f32.to_radians() {
+            if pairs.least() <= 2.0 * TARGET_GAP_MM || phi > angle + 10f32.to_radians() {
                 break;
             }
-            let dphi = (gap.min(2.5 - travelled) - TARGET_GAP_MM).max(0.0) / reach;
+            // Conservative advancement on the angle, pair by pair.
+            let dphi = pairs
+                .pairs
+                .iter()
+                .zip(&pairs.bound)
+                .map(|(&(_, j), b)| (b - TARGET_GAP_MM).max(0.0) / tooth_reach[lower_of[j]])
+                .fold(
+                    (LIST_MARGIN_MM - TARGET_GAP_MM - travelled) / reach,
+                    f32::min,
+                );
             phi += dphi;
-            pairs.advance(dphi * reach);
-            travelled += dphi * reach;
-            if dphi == 0.0 {
-                travelled = 3.0;
+            let (pair_list, bounds) = (&pairs.pairs, &mut pairs.bound);
+            for (&(_, j), b) in pair_list.iter().zip(bounds.iter_mut()) {
+                *b -= dphi * tooth_reach[lower_of[j]];
             }
+            pairs.forget();
+            travelled += dphi * reach;
         }
         pairs.refresh(&close(phi), AREA_TOLERANCE_MM);
         angle = phi;

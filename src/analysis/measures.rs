@@ -9,7 +9,10 @@
 //!   the coverage check) into pieces with edges under [`PIECE_MM`]; a piece counts when its
 //!   centroid's exact distance to the antagonist's mesh is within the tolerance, or the centroid
 //!   lies inside it. Area error: at most the area of the pieces along the patch border, i.e. about
-//!   the patch perimeter × 0.2 mm.
+//!   the patch perimeter × 0.2 mm. Teeth apart (exact gap above zero) are not split where a
+//!   piece's centroid lies farther from the antagonist than the tolerance plus the piece's radius
+//!   (no point of the piece can then count), which gives the same area for far less work; a
+//!   tooth's least gap is the exact mesh distance.
 //! - **IPR**: per contact, flagged above [`IPR_CONTACT_LIMIT_MM`] (0.5 mm) per contact and above
 //!   [`IPR_SURFACE_LIMIT_MM`] (0.25 mm) per surface (half the contact's overlap on each tooth).
 //! - **Bolton** (Bolton 1958): anterior ratio = Σ mandibular / Σ maxillary mesiodistal widths of
@@ -24,7 +27,10 @@
 use serde::Serialize;
 
 use crate::{
-    geometry::{MeshRef, Pose, closest_point_on_mesh, point_inside_mesh},
+    geometry::{
+        MeshRef, Pose, closest_point_on_mesh, closest_point_on_mesh_within, mesh_separation,
+        point_inside_mesh,
+    },
     sphere_tree::coverage::split4,
     teeth::{Arch, Fdi, ToothGeometry},
 };
@@ -87,7 +93,7 @@ pub struct OcclusalContact {
     pub fdi: Fdi,
     /// Surface area in contact (mm²).
     pub area_mm2: f32,
-    /// Least distance to the opposing arch (mm; 0 when overlapping); None when no antagonist
+    /// Least exact distance to the opposing arch (mm; 0 when overlapping); None when no antagonist
     /// comes within the tolerance of its box.
     pub min_gap_mm: Option<f32>,
     /// Opposing teeth it touches.
@@ -126,6 +132,16 @@ pub fn occlusal_contacts(teeth: &[Posed], tolerance: f32) -> Vec<OcclusalContact
                 mesh: &o.geometry.mesh,
                 bvh: &o.geometry.bvh,
             };
+            // The pair's exact gap: beyond the tolerance nothing of it is in contact; apart, no
+            // point of one tooth lies inside the other, so a piece whose centroid lies farther
+            // from the antagonist than the tolerance plus the piece's radius is wholly out of
+            // contact and is not split further.
+            let pair_gap = mesh_separation(t.geometry.mesh_ref(), &t.pose, m, &o.pose).signed_gap();
+            min_gap = min_gap.min(pair_gap.max(0.0));
+            if pair_gap > tolerance {
+                continue;
+            }
+            let apart = pair_gap > 0.0;
             let mut touched = false;
             for k in 0..t.geometry.mesh.triangles.len() {
                 let tri = t
@@ -139,22 +155,38 @@ pub fn occlusal_contacts(teeth: &[Posed], tolerance: f32) -> Vec<OcclusalContact
                 }
                 let mut stack = vec![tri];
                 while let Some(p) = stack.pop() {
+                    let c = (p[0] + p[1] + p[2]) / 3.0;
+                    let local = to_local.transform_point(c);
+                    let radius = p.iter().map(|v| v.distance(c)).fold(0.0f32, f32::max);
                     let edge = p[0]
                         .distance(p[1])
                         .max(p[1].distance(p[2]))
                         .max(p[2].distance(p[0]));
+                    if apart {
+                        let Some((_, d)) =
+                            closest_point_on_mesh_within(m, local, tolerance + radius)
+                        else {
+                            continue;
+                        };
+                        if edge > PIECE_MM {
+                            stack.extend(split4(p));
+                        } else if d <= tolerance {
+                            let a = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+                            area += a;
+                            weighted += c * a;
+                            touched = true;
+                        }
+                        continue;
+                    }
                     if edge > PIECE_MM {
                         stack.extend(split4(p));
                         continue;
                     }
-                    let c = (p[0] + p[1] + p[2]) / 3.0;
-                    let local = to_local.transform_point(c);
                     let Some((_, d)) = closest_point_on_mesh(m, local) else {
                         continue;
                     };
                     let inside = d <= 1.0 && point_inside_mesh(m, local);
                     let gap = if inside { 0.0 } else { d };
-                    min_gap = min_gap.min(gap);
                     if gap <= tolerance {
                         let a = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
                         area += a;
@@ -176,7 +208,20 @@ pub fn occlusal_contacts(teeth: &[Posed], tolerance: f32) -> Vec<OcclusalContact
         }
     };
     let indices: Vec<usize> = (0..teeth.len()).collect();
-    crate::parallel::parallel_map(&indices, |&i| one(i))
+    let mut contacts = crate::parallel::parallel_map(&indices, |&i| one(i));
+    // Contact is mutual: at a pair's closest points each surface lies within the tolerance of the
+    // other, though near the tolerance only one side's sampled pieces may show it.
+    for i in 0..contacts.len() {
+        for a in contacts[i].antagonists.clone() {
+            let fdi = contacts[i].fdi;
+            if let Some(o) = contacts.iter_mut().find(|o| o.fdi == a)
+                && !o.antagonists.contains(&fdi)
+            {
+                o.antagonists.push(fdi);
+            }
+        }
+    }
+    contacts
 }
 
 /// One contact's interproximal reduction and its limits.

@@ -11,22 +11,40 @@ fn dentition(case: &str) -> Dentition {
 }
 
 #[test]
-fn the_normal_bite_settles_onto_both_sides_without_penetration() {
+fn the_normal_arrangement_is_a_class_one_bite_that_settles_without_penetration() {
     let d = dentition("normal");
     let teeth = Posed::of_dentition(&d);
-    // As arranged the arches meet at a point: no stable bite.
-    let before = bite("normal", &teeth, false, 0.0);
-    assert!(!before.stable && before.why.is_some(), "{before:?}");
-    for opening in [0.0, 3.0] {
-        let b = bite("normal", &teeth, true, opening);
-        assert!(b.stable, "{opening} mm: {:?}", b.why);
-        assert!(b.why.is_none());
-        assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+    // As arranged: every premolar and molar of both arches meets an antagonist, the incisors
+    // stand just apart, overjet and overbite about 2 mm.
+    let placed = bite("normal", &teeth, false, 0.0);
+    assert!(placed.max_penetration_mm <= 0.01, "{placed:?}");
+    for f in d
+        .teeth
+        .iter()
+        .map(|t| t.fdi)
+        .filter(|f| f.kind().is_posterior())
+    {
         assert!(
-            b.contact_teeth.left >= 2 && b.contact_teeth.right >= 2,
-            "{b:?}"
+            placed.contacts.iter().any(|c| c.upper == f || c.lower == f),
+            "{f} meets nothing: {placed:?}"
         );
-        assert!(b.contacts.len() > before.contacts.len(), "{b:?}");
+    }
+    let o = d.arrangement;
+    assert!((1.5..2.5).contains(&o.overjet_mm), "{o:?}");
+    assert!((1.5..2.5).contains(&o.overbite_mm), "{o:?}");
+    for (opening, b) in [(None, placed.clone())]
+        .into_iter()
+        .chain([0.0, 3.0].map(|x| (Some(x), bite("normal", &teeth, true, x))))
+    {
+        assert!(b.max_penetration_mm <= 0.01, "{opening:?}: {b:?}");
+        assert!(
+            b.contact_teeth.left >= 4 && b.contact_teeth.right >= 4,
+            "{opening:?}: {b:?}"
+        );
+        assert!(
+            (0.05..=0.3).contains(&b.incisor_gap_mm),
+            "{opening:?}: {b:?}"
+        );
         assert!(
             b.contacts
                 .iter()
@@ -36,6 +54,9 @@ fn the_normal_bite_settles_onto_both_sides_without_penetration() {
             b.contacts.iter().map(|c| c.area_mm2).sum::<f32>() > 0.3,
             "{b:?}"
         );
+        let Some(opening) = opening else { continue };
+        assert!(b.stable, "{opening} mm: {:?}", b.why);
+        assert!(b.why.is_none());
         // It closed from the opening: the lower arch rose by about the opening.
         assert!(b.lower_travel_mm >= opening, "{b:?}");
     }

@@ -17,8 +17,16 @@
 //!    molars' buccal grooves (Angle class I): nested bisections on a fast model (teeth at their
 //!    summed widths along the curves), corrected by what the exact placement then measures. Its
 //!    front lies `overjet_offset` ahead of the lower front.
-//! 3. The upper arch is lowered onto the lower until the least exact gap between the arches is
-//!    `occlusal_gap` (bisection on its height).
+//! 3. The upper arch is lowered onto the lower until the least exact gap between the posterior
+//!    teeth is `occlusal_gap` (bisection on its height).
+//! 4. The bite is levelled as a settled class I bite is: each lower premolar and molar is raised or
+//!    lowered until its exact gap to the upper arch is `occlusal_gap`, each lower incisor until its
+//!    gap is `incisor_gap` (the incisors just out of contact), and a lower canine closer than that
+//!    is lowered to it; then each upper premolar and molar still farther than `occlusal_gap` from
+//!    the lower arch comes down to it, so every posterior tooth of both arches meets its
+//!    antagonists. Both arches are then placed along their curves again at the new heights, so
+//!    adjacent crowns keep their `contact_gap`, and the levelling is repeated until no tooth moves
+//!    by more than 0.001 mm (at most four rounds).
 
 use std::{collections::BTreeMap, sync::Arc};
 
@@ -47,8 +55,11 @@ pub struct ArchLayout {
     pub lower: BetaArch,
     /// Exact gap between adjacent crowns (mm).
     pub contact_gap: f32,
-    /// Least exact gap between the arches (mm).
+    /// Exact gap (mm) between each lower premolar and molar and the upper arch.
     pub occlusal_gap: f32,
+    /// Exact gap (mm) between each lower incisor and the upper arch; the lower canines stand at
+    /// least this far from it.
+    pub incisor_gap: f32,
     /// How far the upper curve's front lies ahead of the lower's at the cervical level (mm); the
     /// incisors' labial inclination adds the rest of the overjet at the incisal edges.
     pub overjet_offset: f32,
@@ -70,7 +81,8 @@ impl Default for ArchLayout {
                 front_z: 18.0,
             },
             contact_gap: 0.05,
-            occlusal_gap: 0.02,
+            occlusal_gap: 0.01,
+            incisor_gap: 0.12,
             overjet_offset: 0.0,
             buccal_overlap: 2.2,
             inclination_deg: [
@@ -145,7 +157,7 @@ fn pose_on_curve(
     fdi: Fdi,
     shape: &ToothGeometry,
     layout: &ArchLayout,
-    lift: f32,
+    raise: f32,
 ) -> Pose {
     let (p, t) = curve.at(s);
     let out = Vec3::new(-t.y, 0.0, t.x);
@@ -154,8 +166,8 @@ fn pose_on_curve(
     let tip = shape.frame.crown_length;
     let level = layout.tip_level[row][k];
     let (up, y) = match fdi.arch() {
-        Arch::Lower => (Vec3::Y, level - tip),
-        Arch::Upper => (-Vec3::Y, -level + tip + lift),
+        Arch::Lower => (Vec3::Y, level - tip + raise),
+        Arch::Upper => (-Vec3::Y, -level + tip + raise),
     };
     let x = up.cross(out);
     let base = Quat::from_mat3(&Mat3::from_cols(x, up, out));
@@ -168,13 +180,15 @@ fn gap(a: &ToothGeometry, pa: &Pose, b: &ToothGeometry, pb: &Pose) -> f32 {
     mesh_separation(a.mesh_ref(), pa, b.mesh_ref(), pb).signed_gap()
 }
 
-/// Places one arch along its curve with adjacent crowns `contact_gap` apart.
+/// Places one arch along its curve with adjacent crowns `contact_gap` apart, each tooth raised by
+/// its entry in `raise` (mm, world +y; none is 0).
 fn place_arch(
     arch: Arch,
     curve: &ArchCurve,
     shapes: &ShapeSet,
     layout: &ArchLayout,
     spaces: &Spaces,
+    raise: &BTreeMap<Fdi, f32>,
 ) -> Vec<(Fdi, Pose, f32)> {
     let quadrant = |side: Side| match (arch, side) {
         (Arch::Upper, Side::Right) => 1,
@@ -186,7 +200,9 @@ fn place_arch(
     let shape = |pos: u8| shapes.get(arch, ToothKind::from_position(pos).expect("position 1-8"));
     let pose = |side: Side, pos: u8, u: f32| {
         let s = if side == Side::Left { u } else { -u };
-        pose_on_curve(curve, s, fdi(side, pos), &shape(pos), layout, 0.0)
+        let f = fdi(side, pos);
+        let r = raise.get(&f).copied().unwrap_or(0.0);
+        pose_on_curve(curve, s, f, &shape(pos), layout, r)
     };
     let central = shape(1);
     let half = 0.5 * central.anatomy.mesiodistal;
@@ -296,10 +312,17 @@ fn solve_upper_form(
             depth: d,
             front_z,
         };
-        place_arch(Arch::Upper, &ArchCurve::new(&form), shapes, layout, spaces)
-            .into_iter()
-            .map(|(f, p, _)| (f, p))
-            .collect()
+        place_arch(
+            Arch::Upper,
+            &ArchCurve::new(&form),
+            shapes,
+            layout,
+            spaces,
+            &BTreeMap::new(),
+        )
+        .into_iter()
+        .map(|(f, p, _)| (f, p))
+        .collect()
     };
     let mut correction = Vec2::ZERO;
     let (mut w, mut d) = solve_model(correction);
@@ -346,54 +369,160 @@ fn nominal_arc(shapes: &ShapeSet, arch: Arch, position: u8) -> f32 {
 /// Extra space (mm) on the mesial side of teeth (a diastema at 21 opens the 11–21 contact).
 pub type Spaces = BTreeMap<Fdi, f32>;
 
-/// Builds the arrangement of all 32 teeth, with extra spaces where asked.
-pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arrangement {
-    let lower: Vec<(Fdi, Pose)> = place_arch(
-        Arch::Lower,
-        &ArchCurve::new(&layout.lower),
-        shapes,
-        layout,
-        spaces,
-    )
-    .into_iter()
-    .map(|(f, p, _)| (f, p))
-    .collect();
-    let (upper_form, upper_residual, upper) = solve_upper_form(shapes, layout, &lower, spaces);
-    let shape_of = |f: Fdi| shapes.get(f.arch(), f.kind());
-    // Opposing pairs whose footprints come near each other.
-    let footprint = |f: Fdi, p: &Pose| {
-        let b = shape_of(f).bvh.root_aabb();
-        let m = Mat3::from_quat(p.rotation);
-        b.transformed(&m, p.translation)
+/// Opposing pairs (upper index, lower index) whose footprints in the occlusal plane come within
+/// 1 mm of each other.
+fn antagonists(
+    shapes: &ShapeSet,
+    upper: &[(Fdi, Pose)],
+    lower: &[(Fdi, Pose)],
+) -> Vec<(usize, usize)> {
+    let flat = |f: Fdi, p: &Pose| {
+        let b = shapes
+            .get(f.arch(), f.kind())
+            .bvh
+            .root_aabb()
+            .transformed(&Mat3::from_quat(p.rotation), p.translation);
+        Aabb {
+            min: b.min.with_y(0.0) - Vec3::splat(1.0),
+            max: b.max.with_y(0.0) + Vec3::splat(1.0),
+        }
     };
     let mut pairs = Vec::new();
-    for (fu, pu) in &upper {
-        for (fl, pl) in &lower {
-            let (bu, bl) = (footprint(*fu, pu), footprint(*fl, pl));
-            let flat = |b: Aabb| Aabb {
-                min: b.min.with_y(0.0) - Vec3::splat(1.0),
-                max: b.max.with_y(0.0) + Vec3::splat(1.0),
-            };
-            if flat(bu).distance_squared(&flat(bl)) == 0.0 {
-                pairs.push((*fu, *pu, *fl, *pl));
+    for (i, (fu, pu)) in upper.iter().enumerate() {
+        for (j, (fl, pl)) in lower.iter().enumerate() {
+            if flat(*fu, pu).distance_squared(&flat(*fl, pl)) == 0.0 {
+                pairs.push((i, j));
             }
         }
     }
+    pairs
+}
+
+/// The pose moved by `dy` along world +y.
+fn lifted(p: &Pose, dy: f32) -> Pose {
+    Pose::new(p.rotation, p.translation + Vec3::Y * dy)
+}
+
+/// How far (mm, along −y) a lower tooth must drop for `least(drop)`, its least gap to the upper
+/// arch, to be `target`: secant steps from the guess that the gap follows the drop one to one,
+/// bisection when they do not settle. The result's gap is at least `target` − 1e-4 mm.
+fn drop_to(mut least: impl FnMut(f32) -> f32, target: f32) -> f32 {
+    let (mut x0, mut g0) = (0.0f32, least(0.0));
+    if (g0 - target).abs() < 1e-4 {
+        return 0.0;
+    }
+    let mut x1 = target - g0;
+    for _ in 0..8 {
+        let g1 = least(x1);
+        if (g1 - target).abs() < 1e-4 && g1 >= target - 1e-4 {
+            return x1;
+        }
+        let slope = (g1 - g0) / (x1 - x0);
+        if !(0.05..=20.0).contains(&slope) {
+            break;
+        }
+        (x0, g0) = (x1, g1);
+        x1 += ((target - g1) / slope).clamp(-1.0, 1.0);
+    }
+    solve_increasing(least, -1.0, 1.0, target)
+}
+
+/// Builds the arrangement of all 32 teeth, with extra spaces where asked.
+pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arrangement {
+    let lower_curve = ArchCurve::new(&layout.lower);
+    let place = |arch: Arch, curve: &ArchCurve, raise: &BTreeMap<Fdi, f32>| -> Vec<(Fdi, Pose)> {
+        place_arch(arch, curve, shapes, layout, spaces, raise)
+            .into_iter()
+            .map(|(f, p, _)| (f, p))
+            .collect()
+    };
+    let mut raise = BTreeMap::new();
+    let mut lower = place(Arch::Lower, &lower_curve, &raise);
+    let (upper_form, upper_residual, upper) = solve_upper_form(shapes, layout, &lower, spaces);
+    let upper_curve = ArchCurve::new(&upper_form);
+    let shape_of = |f: Fdi| shapes.get(f.arch(), f.kind());
+    let posterior = |f: Fdi| f.position() >= 4;
+    // The upper arch comes down until its first posterior contact.
+    let pairs = antagonists(shapes, &upper, &lower);
     let min_gap = |lift: f32| -> f32 {
         pairs
             .iter()
-            .map(|(fu, pu, fl, pl)| {
-                let raised = Pose::new(pu.rotation, pu.translation + Vec3::Y * lift);
-                gap(&shape_of(*fu), &raised, &shape_of(*fl), pl)
+            .filter(|(i, j)| posterior(upper[*i].0) && posterior(lower[*j].0))
+            .map(|(i, j)| {
+                let ((fu, pu), (fl, pl)) = (&upper[*i], &lower[*j]);
+                gap(&shape_of(*fu), &lifted(pu, lift), &shape_of(*fl), pl)
             })
             .fold(f32::INFINITY, f32::min)
     };
     let lift = solve_increasing(min_gap, -1.0, 4.0, layout.occlusal_gap);
-    let mut poses: Vec<(Fdi, Pose)> = upper
-        .into_iter()
-        .map(|(f, p)| (f, Pose::new(p.rotation, p.translation + Vec3::Y * lift)))
-        .chain(lower)
-        .collect();
+    raise.extend(upper.iter().map(|(f, _)| (*f, lift)));
+    let mut upper: Vec<(Fdi, Pose)> = upper.iter().map(|(f, p)| (*f, lifted(p, lift))).collect();
+    // Each lower tooth is levelled against the upper arch, then each upper premolar and molar not
+    // yet meeting the lower arch comes down onto it; both arches are then placed along their
+    // curves again at the new heights (which keeps the crowns' proximal contacts), until the
+    // levels hold.
+    for _ in 0..LEVELLING_ROUNDS {
+        let pairs = antagonists(shapes, &upper, &lower);
+        // The upper teeth facing lower tooth `k` (`of_lower`), or the lower teeth facing upper `k`.
+        let facing = |k: usize, of_lower: bool| -> Vec<usize> {
+            pairs
+                .iter()
+                .filter(|(u, l)| if of_lower { *l == k } else { *u == k })
+                .map(|(u, l)| if of_lower { *u } else { *l })
+                .collect()
+        };
+        let mut largest = 0.0f32;
+        for (j, (fl, pl)) in lower.iter().enumerate() {
+            let facing = facing(j, true);
+            if facing.is_empty() {
+                continue;
+            }
+            let least = |drop: f32| -> f32 {
+                facing
+                    .iter()
+                    .map(|i| {
+                        let (fu, pu) = &upper[*i];
+                        gap(&shape_of(*fu), pu, &shape_of(*fl), &lifted(pl, -drop))
+                    })
+                    .fold(f32::INFINITY, f32::min)
+            };
+            let target = match fl.kind() {
+                _ if posterior(*fl) => layout.occlusal_gap,
+                ToothKind::Canine if least(0.0) >= layout.incisor_gap => continue,
+                _ => layout.incisor_gap,
+            };
+            let drop = drop_to(least, target);
+            *raise.entry(*fl).or_insert(0.0) -= drop;
+            largest = largest.max(drop.abs());
+        }
+        lower = place(Arch::Lower, &lower_curve, &raise);
+        for (i, (fu, pu)) in upper.iter().enumerate() {
+            let facing = facing(i, false);
+            if !posterior(*fu) || facing.is_empty() {
+                continue;
+            }
+            let least = |up: f32| -> f32 {
+                facing
+                    .iter()
+                    .map(|j| {
+                        let (fl, pl) = &lower[*j];
+                        gap(&shape_of(*fu), &lifted(pu, up), &shape_of(*fl), pl)
+                    })
+                    .fold(f32::INFINITY, f32::min)
+            };
+            if least(0.0) <= layout.occlusal_gap + 1e-3 {
+                continue;
+            }
+            let up = drop_to(least, layout.occlusal_gap);
+            *raise.entry(*fu).or_insert(0.0) += up;
+            largest = largest.max(up.abs());
+        }
+        upper = place(Arch::Upper, &upper_curve, &raise);
+        if largest < 1e-3 {
+            break;
+        }
+    }
+    let mut poses: Vec<(Fdi, Pose)> = upper.into_iter().chain(lower).collect();
     poses.sort_by_key(|(f, _)| *f);
     let measures = measure_occlusion(shapes, &poses);
     Arrangement {
@@ -403,3 +532,6 @@ pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arran
         measures,
     }
 }
+
+/// Most rounds of levelling the lower teeth against the upper arch.
+const LEVELLING_ROUNDS: usize = 4;
