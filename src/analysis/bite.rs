@@ -2,9 +2,10 @@
 //! stable (`orthosim occlusion --settle`).
 //!
 //! Quasi-static settle. The lower arch rises along the occlusal direction (+y) under a bite force
-//! whose line passes through the centroid of its crown centres. Each iteration measures every
-//! opposing pair whose boxes come near with the exact mesh distance; pairs within
-//! [`CONTACT_MM`] are contacts, each pushing along its normal (from the upper tooth's closest
+//! whose line passes through the centroid of its crown centres. Every opposing pair whose boxes
+//! come near carries a lower bound on its gap; each iteration measures with the exact mesh
+//! distance the pairs whose bound is near contact (queries bounded to [`SETTLE_LIMIT_MM`]: a
+//! farther pair only learns that it is farther); pairs within [`CONTACT_MM`] are contacts, each pushing along its normal (from the upper tooth's closest
 //! point to the lower's). The lower arch's motion is the bite force's, less what the contacts
 //! take (the contact solve of the PDL model on two bodies: the upper arch fixed, the lower with a
 //! mobility of 1 mm per N in translation and 1/R² in rotation, R = [`TURN_RADIUS_MM`]). It moves
@@ -24,7 +25,7 @@ use serde::Serialize;
 
 use super::measures::{Posed, occlusal_contacts};
 use crate::{
-    geometry::{Mat6, MeshRef, Pose, halves, mesh_separation, vec6},
+    geometry::{Mat6, Pose, halves, mesh_separation, mesh_separation_within, vec6},
     movement::pdl::{ContactRow, PdlBody, SolveParams, solve_contacts},
     teeth::{Arch, Fdi, ToothKind},
 };
@@ -41,6 +42,9 @@ pub const STILL_MM: f64 = 1e-4;
 pub const MAX_ITERATIONS: usize = 400;
 /// Surface within this distance (mm) of the opposing tooth counts towards a contact's area.
 pub const AREA_TOLERANCE_MM: f32 = 0.05;
+/// A settle measures opposing pairs exactly only when they are this near (mm); a farther pair's
+/// bound is this distance. It limits the settle's step to about this much motion.
+pub const SETTLE_LIMIT_MM: f32 = 1.0;
 
 /// One opposing pair in the bite.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -101,91 +105,78 @@ fn upper(t: &Posed) -> bool {
     t.fdi.arch() == Arch::Upper
 }
 
-/// Exact separations of the opposing pairs whose boxes come within `margin`, with the lower
-/// arch moved by `moved` (applied to every lower tooth's pose).
-pub(super) fn separations(
-    teeth: &[Posed],
-    moved: &Pose,
-    margin: f32,
-) -> Vec<(usize, usize, crate::geometry::MeshSeparation)> {
-    let pose = |t: &Posed| {
-        if upper(t) { t.pose } else { moved.mul(&t.pose) }
-    };
-    let boxes: Vec<_> = teeth
-        .iter()
-        .map(|t| {
-            let p = pose(t);
-            t.geometry
-                .mesh
-                .aabb()
-                .transformed(&glam::Mat3::from_quat(p.rotation), p.translation)
-        })
-        .collect();
-    let mut out = Vec::new();
-    for (i, u) in teeth.iter().enumerate().filter(|(_, t)| upper(t)) {
-        for (j, l) in teeth.iter().enumerate().filter(|(_, t)| !upper(t)) {
-            let (a, b) = (&boxes[i], &boxes[j]);
-            let m = Vec3::splat(margin);
-            if !((a.min - m).cmple(b.max).all() && (b.min - m).cmple(a.max).all()) {
-                continue;
-            }
-            let s = mesh_separation(
-                MeshRef {
-                    mesh: &u.geometry.mesh,
-                    bvh: &u.geometry.bvh,
-                },
-                &pose(u),
-                MeshRef {
-                    mesh: &l.geometry.mesh,
-                    bvh: &l.geometry.bvh,
-                },
-                &pose(l),
-            );
-            out.push((i, j, s));
-        }
-    }
-    out
-}
-
-/// The opposing pairs a settle may bring together, each with a lower bound on its gap: measured
-/// exactly when it may be near, otherwise its last measure less how far any lower point has
-/// moved since (a conservative bound, so a pair left unmeasured cannot be in contact).
+/// The opposing pairs a settle or an excursion may bring together, each with a lower bound on its
+/// gap: measured exactly when it may be near, otherwise its last measure (or the distance of the
+/// two teeth's boxes) less how far any lower point has moved since. The bound is conservative, so
+/// a pair left unmeasured cannot be in contact.
 pub(super) struct Tracker<'a, 'b> {
     teeth: &'b [Posed<'a>],
     pub(super) pairs: Vec<(usize, usize)>,
     pub(super) bound: Vec<f32>,
+    /// The exact separation at the current pose, when measured there.
     pub(super) last: Vec<Option<crate::geometry::MeshSeparation>>,
+    /// Whether `bound` was found at the current pose (exactly, or as a query's limit).
+    pub(super) fresh: Vec<bool>,
 }
 
 impl<'a, 'b> Tracker<'a, 'b> {
-    /// Pairs whose boxes come within `margin` at `moved`, all measured.
-    pub(super) fn new(teeth: &'b [Posed<'a>], moved: &Pose, margin: f32) -> Self {
-        let seps = separations(teeth, moved, margin);
-        Self {
+    /// Pairs whose boxes come within `margin` at `moved`, none measured: each bound is the
+    /// distance between the two teeth's boxes (0 for boxes that overlap).
+    pub(super) fn boxed(teeth: &'b [Posed<'a>], moved: &Pose, margin: f32) -> Self {
+        let boxes: Vec<_> = teeth
+            .iter()
+            .map(|t| {
+                let p = if upper(t) { t.pose } else { moved.mul(&t.pose) };
+                t.geometry
+                    .mesh
+                    .aabb()
+                    .transformed(&glam::Mat3::from_quat(p.rotation), p.translation)
+            })
+            .collect();
+        let mut tracker = Self {
             teeth,
-            pairs: seps.iter().map(|(i, j, _)| (*i, *j)).collect(),
-            bound: seps.iter().map(|(_, _, s)| s.signed_gap()).collect(),
-            last: seps.into_iter().map(|(_, _, s)| Some(s)).collect(),
+            pairs: Vec::new(),
+            bound: Vec::new(),
+            last: Vec::new(),
+            fresh: Vec::new(),
+        };
+        for (i, _) in teeth.iter().enumerate().filter(|(_, t)| upper(t)) {
+            for (j, _) in teeth.iter().enumerate().filter(|(_, t)| !upper(t)) {
+                let d = boxes[i].distance_squared(&boxes[j]).sqrt();
+                if d <= margin {
+                    tracker.pairs.push((i, j));
+                    tracker.bound.push(d);
+                    tracker.last.push(None);
+                    tracker.fresh.push(false);
+                }
+            }
         }
+        tracker
     }
 
-    fn measure(&self, k: usize, moved: &Pose) -> crate::geometry::MeshSeparation {
+    /// Measures pair `k` at `moved` if its gap is `limit` or less; otherwise its bound becomes the
+    /// limit (a query that opens only the parts of the two hierarchies within the limit).
+    pub(super) fn measure_within(&mut self, k: usize, moved: &Pose, limit: f32) {
         let (u, l) = (&self.teeth[self.pairs[k].0], &self.teeth[self.pairs[k].1]);
-        mesh_separation(
+        let s = mesh_separation_within(
             u.geometry.mesh_ref(),
             &u.pose,
             l.geometry.mesh_ref(),
             &moved.mul(&l.pose),
-        )
+            limit,
+        );
+        self.bound[k] = s.map_or(limit.max(self.bound[k]), |s| s.signed_gap());
+        self.last[k] = s;
+        self.fresh[k] = true;
     }
 
-    /// Measures every pair whose bound is `near` or less.
-    pub(super) fn refresh(&mut self, moved: &Pose, near: f32) {
+    /// Makes sure of every pair whose bound is `near` or less, at `moved`: measured exactly if its
+    /// gap is `limit` (at least `near`) or less, otherwise its bound raised to `limit`.
+    pub(super) fn refresh_within(&mut self, moved: &Pose, near: f32, limit: f32) {
         for k in 0..self.pairs.len() {
-            if self.bound[k] <= near {
-                let s = self.measure(k, moved);
-                self.bound[k] = s.signed_gap();
-                self.last[k] = Some(s);
+            let known = self.last[k].is_some() || self.fresh[k] && self.bound[k] >= near;
+            if self.bound[k] <= near && !known {
+                self.measure_within(k, moved, limit.max(near));
             }
         }
     }
@@ -193,6 +184,16 @@ impl<'a, 'b> Tracker<'a, 'b> {
     /// The lower arch moved (the caller lowered the bounds): the last measures are stale.
     pub(super) fn forget(&mut self) {
         self.last.fill(None);
+        self.fresh.fill(false);
+    }
+
+    /// The least gap measured exactly at the current pose (infinite if none is).
+    pub(super) fn least_measured(&self) -> f32 {
+        self.last
+            .iter()
+            .flatten()
+            .map(|s| s.signed_gap())
+            .fold(f32::INFINITY, f32::min)
     }
 
     /// The least bound.
@@ -207,9 +208,16 @@ impl<'a, 'b> Tracker<'a, 'b> {
         let mut measured = Vec::new();
         for k in 0..self.pairs.len() {
             if self.bound[k] - delta <= 2.0 * CONTACT_MM {
-                let s = self.measure(k, next);
+                let (u, l) = (&self.teeth[self.pairs[k].0], &self.teeth[self.pairs[k].1]);
+                let s = mesh_separation_within(
+                    u.geometry.mesh_ref(),
+                    &u.pose,
+                    l.geometry.mesh_ref(),
+                    &next.mul(&l.pose),
+                    SETTLE_LIMIT_MM,
+                );
                 // A pair already closer than the floor may not get closer still.
-                if s.signed_gap() < floor.min(self.bound[k] - 1e-6) {
+                if s.is_some_and(|s| s.signed_gap() < floor.min(self.bound[k] - 1e-6)) {
                     return false;
                 }
                 measured.push((k, s));
@@ -218,12 +226,11 @@ impl<'a, 'b> Tracker<'a, 'b> {
         for b in &mut self.bound {
             *b -= delta;
         }
-        for l in &mut self.last {
-            *l = None;
-        }
+        self.forget();
         for (k, s) in measured {
-            self.bound[k] = s.signed_gap();
-            self.last[k] = Some(s);
+            self.bound[k] = s.map_or(SETTLE_LIMIT_MM, |s| s.signed_gap());
+            self.last[k] = s;
+            self.fresh[k] = true;
         }
         true
     }
@@ -270,9 +277,10 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         max_sweeps: 2_000,
     };
     let travel_limit = opening_mm.max(0.0) + 10.0;
-    let mut pairs = Tracker::new(teeth, &moved, opening_mm.max(0.0) + 3.0);
+    let mut pairs = Tracker::boxed(teeth, &moved, opening_mm.max(0.0) + 3.0);
+    pairs.refresh_within(&moved, f32::INFINITY, SETTLE_LIMIT_MM);
     loop {
-        pairs.refresh(&moved, 2.0 * CONTACT_MM);
+        pairs.refresh_within(&moved, 2.0 * CONTACT_MM, SETTLE_LIMIT_MM);
         let c = moved.transform_point(centre).as_dvec3();
         let contacts: Vec<ContactRow> = pairs
             .last
@@ -383,16 +391,32 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
             pose: if upper(t) { t.pose } else { moved.mul(&t.pose) },
         })
         .collect();
-    let seps = separations(teeth, &moved, AREA_TOLERANCE_MM);
-    let mut contacts = Vec::new();
-    let mut max_penetration = 0.0f32;
-    let mut incisor_gap = f32::INFINITY;
     let incisor = |f: Fdi| {
         matches!(
             f.kind(),
             ToothKind::CentralIncisor | ToothKind::LateralIncisor
         )
     };
+    // Every pair within the area tolerance, measured exactly; the incisors at any gap.
+    let mut listed = Tracker::boxed(teeth, &moved, AREA_TOLERANCE_MM);
+    for k in 0..listed.pairs.len() {
+        let (i, j) = listed.pairs[k];
+        let limit = if incisor(teeth[i].fdi) && incisor(teeth[j].fdi) {
+            f32::INFINITY
+        } else {
+            AREA_TOLERANCE_MM
+        };
+        listed.measure_within(k, &moved, limit);
+    }
+    let seps: Vec<_> = listed
+        .pairs
+        .iter()
+        .zip(&listed.last)
+        .filter_map(|(&(i, j), s)| s.map(|s| (i, j, s)))
+        .collect();
+    let mut contacts = Vec::new();
+    let mut max_penetration = 0.0f32;
+    let mut incisor_gap = f32::INFINITY;
     for (i, j, s) in &seps {
         let gap = s.signed_gap();
         max_penetration = max_penetration.max(-gap);

@@ -10,6 +10,13 @@
 //! upper arch (conservative advancement on the closing angle with the exact mesh distance, so the
 //! arches never interpenetrate).
 //!
+//! The closing is lazy: every opposing pair whose boxes come within a few millimetres carries a
+//! lower bound on its gap (first the distance of the boxes, then its last exact measure less how
+//! far its lower tooth can have moved), and a pair is measured only when its bound would shorten
+//! the step, with a query bounded to the distance that matters (parts of the two teeth farther
+//! than that are never opened). The step taken is the least any bound allows, so it stays
+//! conservative whichever pairs were measured.
+//!
 //! Guidance at each step (contacts within [`super::bite::AREA_TOLERANCE_MM`]): `anterior` when
 //! only incisors and canines touch, `canine` when on the working side only the canine touches,
 //! `group function` when premolars or molars of the working side touch too, `none` when nothing
@@ -207,33 +214,54 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         // Start open by 1° and close; open further while the slide alone brings the teeth
         // together.
         let mut phi = angle - 1f32.to_radians();
-        let mut pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
-        while pairs.least() < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
+        let listed = |phi: f32| {
+            let mut pairs = Tracker::boxed(teeth, &close(phi), LIST_MARGIN_MM);
+            pairs.refresh_within(&close(phi), TARGET_GAP_MM, TARGET_GAP_MM);
+            pairs
+        };
+        let mut pairs = listed(phi);
+        while pairs.least_measured() < TARGET_GAP_MM && phi > angle - 30f32.to_radians() {
             phi -= 2f32.to_radians();
-            pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
+            pairs = listed(phi);
         }
         // Motion since the pairs were listed: past RELIST_MM a pair beyond the margin could come
         // near, so they are listed again.
         let mut travelled = 0.0f32;
         for _ in 0..400 {
             if travelled > RELIST_MM {
-                pairs = Tracker::new(teeth, &close(phi), LIST_MARGIN_MM);
+                pairs = Tracker::boxed(teeth, &close(phi), LIST_MARGIN_MM);
                 travelled = 0.0;
             }
-            pairs.refresh(&close(phi), 0.5);
-            if pairs.least() <= 2.0 * TARGET_GAP_MM || phi > angle + 10f32.to_radians() {
+            let here = close(phi);
+            pairs.refresh_within(&here, 2.0 * TARGET_GAP_MM, 2.0 * TARGET_GAP_MM);
+            if pairs.least_measured() <= 2.0 * TARGET_GAP_MM || phi > angle + 10f32.to_radians() {
                 break;
             }
-            // Conservative advancement on the angle, pair by pair.
-            let dphi = pairs
-                .pairs
-                .iter()
-                .zip(&pairs.bound)
-                .map(|(&(_, j), b)| (b - TARGET_GAP_MM).max(0.0) / tooth_reach[lower_of[j]])
-                .fold(
-                    (LIST_MARGIN_MM - TARGET_GAP_MM - travelled) / reach,
-                    f32::min,
-                );
+            // Conservative advancement on the angle, pair by pair. In order of the closing their
+            // bounds allow, each pair that could allow less than the least found so far is
+            // measured, only as far as twice that least (so the bound it gets will not hold the
+            // next, shorter steps back); any bound is safe to step by, the queries only lengthen
+            // the step.
+            let cap = (LIST_MARGIN_MM - TARGET_GAP_MM - travelled) / reach;
+            let allows = |pairs: &Tracker, k: usize| {
+                (pairs.bound[k] - TARGET_GAP_MM).max(0.0) / tooth_reach[lower_of[pairs.pairs[k].1]]
+            };
+            let mut order: Vec<(f32, usize)> = (0..pairs.pairs.len())
+                .map(|k| (allows(&pairs, k), k))
+                .filter(|(d, _)| *d < cap)
+                .collect();
+            order.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut dphi = cap;
+            for (d, k) in order {
+                if d >= dphi {
+                    break;
+                }
+                let limit = TARGET_GAP_MM + 2.0 * dphi * tooth_reach[lower_of[pairs.pairs[k].1]];
+                if pairs.last[k].is_none() && !(pairs.fresh[k] && pairs.bound[k] >= limit) {
+                    pairs.measure_within(k, &here, limit);
+                }
+                dphi = dphi.min(allows(&pairs, k));
+            }
             phi += dphi;
             let (pair_list, bounds) = (&pairs.pairs, &mut pairs.bound);
             for (&(_, j), b) in pair_list.iter().zip(bounds.iter_mut()) {
@@ -242,7 +270,7 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
             pairs.forget();
             travelled += dphi * reach;
         }
-        pairs.refresh(&close(phi), AREA_TOLERANCE_MM);
+        pairs.refresh_within(&close(phi), AREA_TOLERANCE_MM, AREA_TOLERANCE_MM);
         angle = phi;
         let placed = close(phi);
         let mut contacts = Vec::new();

@@ -34,7 +34,8 @@ pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
 pub use mat6::{Mat6, Vec6, halves, vec6};
 pub use mesh_distance::{
     MeshRef, MeshSeparation, NearContact, closest_point_on_mesh, closest_point_on_mesh_within,
-    closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation, point_inside_mesh,
+    closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation,
+    mesh_separation_within, point_inside_mesh,
 };
 pub use pose::Pose;
 pub use section::section_loops;
