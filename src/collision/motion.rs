@@ -174,6 +174,19 @@ impl<T: Copy + Default> NodeCache<T> {
         }
     }
 
+    /// Sets the value of node `i` for this query.
+    #[inline]
+    pub(crate) fn set(&mut self, i: usize, v: T) {
+        self.values[i] = v;
+        self.stamps[i] = self.now;
+    }
+
+    /// True when node `i` has a value in this query.
+    #[inline]
+    pub(crate) fn has(&self, i: usize) -> bool {
+        self.stamps[i] == self.now
+    }
+
     /// The value of node `i` by reference, computed by `f` on first use in this query.
     #[inline]
     pub(crate) fn get_ref(&mut self, i: usize, f: impl FnOnce() -> T) -> &T {

@@ -11,6 +11,13 @@ pub struct Aabb {
     pub max: Vec3,
 }
 
+impl Default for Aabb {
+    /// The empty box.
+    fn default() -> Self {
+        Self::EMPTY
+    }
+}
+
 impl Aabb {
     /// The empty box (the identity of [`Aabb::union`]).
     pub const EMPTY: Self = Self {

@@ -23,7 +23,7 @@ mod stars;
 pub(crate) mod trimesh;
 
 pub use aabb::Aabb;
-pub use bvh::TriangleBvh;
+pub use bvh::{NO_PARENT, Slab, TriangleBvh};
 pub use closest::{
     FacePlane, TrianglePair, closest_point_triangle, closest_points_facing_triangles,
     closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,

@@ -31,7 +31,22 @@ fn teeth_branching(
     depth: u32,
     pairs: &[(u8, u8)],
 ) -> Vec<(TestTooth, TestTooth)> {
-    let d = Dentition::build(Case::resolve("normal").unwrap()).unwrap();
+    teeth_at(method, branching, depth, pairs, None)
+}
+
+/// Teeth of the normal case at `vertices` per tooth (the case's resolution when `None`).
+fn teeth_at(
+    method: TreeMethod,
+    branching: u32,
+    depth: u32,
+    pairs: &[(u8, u8)],
+    vertices: Option<u32>,
+) -> Vec<(TestTooth, TestTooth)> {
+    let mut case = Case::resolve("normal").unwrap();
+    if vertices.is_some() {
+        case.case.resolution = vertices;
+    }
+    let d = Dentition::build(case).unwrap();
     let settings = TreeSettings {
         method,
         branching,
@@ -360,4 +375,18 @@ fn adversarial_motions() {
         Motion::still(l.rest),
     )
     .expect("the molars meet");
+}
+
+/// At scan resolution (10,100 vertices, 21,168 triangles per tooth) the exact stage searches its
+/// many candidates through the triangle hierarchies: the same guarantees against parry on a
+/// smaller seeded set.
+#[test]
+fn scan_resolution_keeps_the_guarantees() {
+    let pairs = teeth_at(TreeMethod::Medial, 8, 4, &PAIRS[..3], Some(10_100));
+    let t = run(&pairs, 90, 0x5ca1_ab1e, false);
+    eprintln!("{t:?}");
+    assert!(t.touching > 10, "{t:?}");
+    assert_eq!(t.false_negatives, [0; 4], "{t:?}");
+    assert_eq!(t.late, 0, "{t:?}");
+    assert_eq!(t.gap_errors, 0, "{t:?}");
 }

@@ -1,3 +1,4 @@
+use super::drift::Relative;
 use super::*;
 use crate::{collision::sampling::Rng, geometry::Pose};
 use glam::Quat;
@@ -42,7 +43,9 @@ fn directional_steps_keep_half_the_tolerance() {
             PlacedTri::new(y_local.map(|v| rel.apply(v))),
         );
         let n = (ty.centre - tx.centre).normalize();
-        let Some(drift) = Relative::new(&ma, &mb, rho_b).drift(t0, to_a, n, &rel) else {
+        let Some(drift) =
+            Relative::new(&ma, &mb, rho_b).drift(t0, to_a, n, &rel, 0.5 * GAP_TOLERANCE_MM as f64)
+        else {
             continue;
         };
         let step = drift.step(&tx, &ty).min(1.0 - t0);
