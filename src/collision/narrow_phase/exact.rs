@@ -214,6 +214,58 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact, tol: f64) -> Op
     }
 }
 
+/// What a step's search leads to.
+enum Settled {
+    /// The contact to report.
+    Report(PairContact),
+    /// Nothing moves: no contact.
+    Stuck,
+    /// Advance: half the tolerance and the plain step.
+    Step { h: f64, plain: f64 },
+}
+
+/// What decides, after each step's search, whether the advancement stops.
+struct Settle<'x, 'y> {
+    a: &'x Body<'y>,
+    b: &'x Body<'y>,
+    swept: &'x continuous::SweptContact,
+    tol: f64,
+    mu: f64,
+}
+
+impl Settle<'_, '_> {
+    /// The search found the gap `d` between `q` (first tooth's frame) at time `t`: within the
+    /// tolerance, or at the `last` step, the contact is reported here (still never after the
+    /// meshes' contact); otherwise every pair is at least d apart and closes at most μ per unit
+    /// time, so a plain step of (d − h)/μ keeps h, half the tolerance. The pairs near the
+    /// contact, which limit that step, usually separate along the closest direction much more
+    /// slowly than μ: the caller extends it as far as every pair allows (see [`drift::Drift`]).
+    fn settle(
+        &self,
+        t: f64,
+        d: f32,
+        q: [Vec3; 2],
+        frame: &Frame,
+        ids: [&[u32]; 2],
+        last: bool,
+    ) -> Settled {
+        let q = q.map(|p| frame.pose_a.transform_point(p));
+        let d = d as f64;
+        if d <= self.tol || last {
+            let c = report(self.a, self.b, self.swept, t, d, q, frame, ids[0], ids[1]);
+            return Settled::Report(c);
+        }
+        if self.mu <= 0.0 {
+            return Settled::Stuck;
+        }
+        let h = 0.5 * self.tol;
+        Settled::Step {
+            h,
+            plain: (d - h) / self.mu,
+        }
+    }
+}
+
 /// The contact found at time `t`, gap `d` between the closest points `q` (world):
 /// for teeth touching or interpenetrating, the depth of the whole meshes near the candidates.
 #[allow(clippy::too_many_arguments)]

@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use super::drift::{Drift, Relative};
-use super::{Frame, MAX_STEPS, PlacedTri, relative, report};
+use super::{Frame, MAX_STEPS, PlacedTri, Settle, Settled, relative};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::lanes::Affine32;
 use crate::collision::narrow_phase::{Body, PairContact, continuous};
@@ -535,6 +535,13 @@ fn advance_with(
         .min_by(|x, y| x.0.total_cmp(&y.0))
         .map_or(Vec3::X, |(_, v)| v.normalize_or(Vec3::X));
     let mut nearest: Option<(u32, u32)> = None;
+    let ctx = Settle {
+        a,
+        b,
+        swept,
+        tol,
+        mu,
+    };
     for round in 0..=MAX_STEPS {
         // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
         let Frame {
@@ -560,26 +567,18 @@ fn advance_with(
         }
         nearest = Some(pair);
         axis = (qb - qa).normalize_or(axis);
-        let (qa, qb) = (pose_a.transform_point(qa), pose_a.transform_point(qb));
-        let d = d as f64;
-        // Within the tolerance, or out of steps: report here (still never after the contact).
-        if d <= tol || round == MAX_STEPS {
-            let frame = Frame {
-                pose_a,
-                pose_b,
-                to_a,
-                rel,
-            };
-            return Some(report(a, b, swept, t, d, [qa, qb], &frame, &ids_a, &ids_b));
-        }
-        if mu <= 0.0 {
-            return None;
-        }
-        // Every pair is at least d apart and closes at most μ per unit time; the pairs near the
-        // contact, which limit that step, usually separate along the closest direction much more
-        // slowly than μ: extend the step as far as every pair allows (see [`Drift`]).
-        let h = 0.5 * tol;
-        let plain = (d - h) / mu;
+        let frame = Frame {
+            pose_a,
+            pose_b,
+            to_a,
+            rel,
+        };
+        let last = round == MAX_STEPS;
+        let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, [&ids_a, &ids_b], last) {
+            Settled::Report(c) => return Some(c),
+            Settled::Stuck => return None,
+            Settled::Step { h, plain } => (h, plain),
+        };
         let mut step = plain;
         if let Some(drift) = motions.drift(t, to_a, axis, &rel, h) {
             let (tx, ty) = (search.tri_a(pair.0), search.tri_b(pair.1));
