@@ -40,6 +40,14 @@ fn scan_resolution(c: &mut Criterion) {
         format!("Medial/FirstMolar/{}_triangles", g.mesh.triangles.len()),
         |b| b.iter(|| settings(TreeMethod::Medial).build(&g.mesh, &g.bvh).unwrap()),
     );
+    // The triangle hierarchy (boxes and slabs) every tooth also gets.
+    group.bench_function(
+        format!(
+            "TriangleBvh/FirstMolar/{}_triangles",
+            g.mesh.triangles.len()
+        ),
+        |b| b.iter(|| orthosim::geometry::TriangleBvh::build(&g.mesh)),
+    );
     group.finish();
 }
 

@@ -14,6 +14,7 @@ pub mod inspect;
 pub mod measures;
 pub mod occlusal_map;
 pub mod occlusion;
+pub mod pareto_plot;
 pub mod plot;
 pub mod report;
 

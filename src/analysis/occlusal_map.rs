@@ -133,18 +133,5 @@ pub fn occlusal_map_png(
     arch: Arch,
     title: &str,
 ) -> Result<(), AnalysisError> {
-    let tmp = path.with_extension(format!("tmp-{}.png", std::process::id()));
-    draw(
-        BitMapBackend::new(&tmp, (700, 620)).into_drawing_area(),
-        teeth,
-        arch,
-        title,
-    )?;
-    std::fs::rename(&tmp, path).map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        AnalysisError::Output(crate::io::OutputError::Write {
-            path: path.to_owned(),
-            source,
-        })
-    })
+    super::plot::write_png(path, (700, 620), |root| draw(root, teeth, arch, title))
 }

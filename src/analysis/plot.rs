@@ -160,14 +160,21 @@ pub fn png(
     labels: &[String],
     series: &[Series],
 ) -> Result<(), AnalysisError> {
+    write_png(path, (1100, 760), |root| draw(root, title, labels, series))
+}
+
+/// Draws a `size` picture with `draw` into a PNG beside `path`, then renames it into place, so
+/// no half-written file is ever left at `path`.
+pub(super) fn write_png(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), AnalysisError>,
+) -> Result<(), AnalysisError> {
     let name = path
         .file_name()
         .map_or_else(|| "plot".into(), |n| n.to_string_lossy().into_owned());
     let tmp = path.with_file_name(format!(".{name}.tmp-{}.png", std::process::id()));
-    {
-        let root = BitMapBackend::new(&tmp, (1100, 760)).into_drawing_area();
-        draw(root, title, labels, series)?;
-    }
+    draw(BitMapBackend::new(&tmp, size).into_drawing_area())?;
     std::fs::rename(&tmp, path).map_err(|source| {
         let _ = std::fs::remove_file(&tmp);
         AnalysisError::Output(OutputError::Write {

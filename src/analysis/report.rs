@@ -20,7 +20,7 @@ use super::{
     plot,
 };
 use crate::{
-    collision::Method,
+    collision::{Method, bench, bench::ParetoPoint},
     geometry::Pose,
     io::{OutputError, check_output, write_atomic},
     movement::{MovementSettings, Response, run_case},
@@ -43,6 +43,56 @@ pub struct ReportOptions {
     pub settings: MovementSettings,
     /// Step limit per run.
     pub max_steps: u64,
+    /// Vertices per procedural tooth of the exact stage's run time against error (`None`: the
+    /// sweep is left out).
+    pub sweep_vertices: Option<u32>,
+    /// Near-contact pair steps of that sweep.
+    pub sweep_pairs: usize,
+}
+
+/// The exact stage's run time against error on the normal case (`orthosim bench --sweep`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SweepSummary {
+    /// Vertices per procedural tooth.
+    pub vertices: u32,
+    /// Mean triangles per tooth.
+    pub triangles_per_tooth: usize,
+    /// Near-contact pair steps.
+    pub pairs: usize,
+    /// Timed passes per tolerance.
+    pub passes: usize,
+    /// Per tolerance.
+    pub pareto: Vec<ParetoPoint>,
+}
+
+/// Passes timed per tolerance in the report's sweep.
+const SWEEP_PASSES: usize = 3;
+
+/// The sweep of the normal case's teeth at `vertices` per tooth.
+fn sweep_summary(opts: &ReportOptions, vertices: u32) -> Result<SweepSummary, AnalysisError> {
+    let mut loaded = Case::resolve("normal")?;
+    loaded.case.resolution = Some(vertices);
+    let dentition = Dentition::build(loaded)?;
+    let teeth = bench::bench_teeth(&dentition, opts.trees, opts.cache.as_ref())?;
+    let near = bench::near_contact_pairs(&teeth, opts.sweep_pairs, 0x5eed);
+    let pareto = bench::sweep(
+        &teeth,
+        &near,
+        &bench::SWEEP_TOLERANCES_MM,
+        SWEEP_PASSES,
+        &|_| {},
+    );
+    Ok(SweepSummary {
+        vertices,
+        triangles_per_tooth: teeth
+            .iter()
+            .map(|t| t.shape.geometry.mesh.triangles.len())
+            .sum::<usize>()
+            / teeth.len().max(1),
+        pairs: near.len(),
+        passes: SWEEP_PASSES,
+        pareto,
+    })
 }
 
 /// One method's outcome on one case.
@@ -102,6 +152,8 @@ pub struct Summary {
     pub biomechanics: super::Validation,
     /// The built-in normal case's bite, settled (`orthosim occlusion --settle`).
     pub bite: super::Bite,
+    /// The exact stage's run time against error, if asked for.
+    pub sweep: Option<SweepSummary>,
 }
 
 /// A row of `distances.csv`.
@@ -148,6 +200,10 @@ pub fn run_report(
         outputs.push(out.join(format!("{}.svg", loaded.case.name)));
         outputs.push(out.join(format!("{}.png", loaded.case.name)));
         resolved.push(loaded);
+    }
+    if opts.sweep_vertices.is_some() {
+        outputs.push(out.join("pareto.svg"));
+        outputs.push(out.join("pareto.png"));
     }
     let inputs: Vec<&Path> = opts.cases.iter().map(Path::new).collect();
     for o in &outputs {
@@ -354,6 +410,23 @@ pub fn run_report(
         )?;
         maps.push((title.to_owned(), svg));
     }
+    let mut pareto_svg = None;
+    let sweep = match opts.sweep_vertices {
+        Some(n) => {
+            progress("run time against error", total, total);
+            let sweep = sweep_summary(opts, n)?;
+            let title = format!(
+                "exact stage, run time against error ({} triangles per tooth, {} near-contact steps)",
+                sweep.triangles_per_tooth, sweep.pairs
+            );
+            let svg = super::pareto_plot::pareto_svg(&title, &sweep.pareto)?;
+            write_atomic(&out.join("pareto.svg"), &svg)?;
+            super::pareto_plot::pareto_png(&out.join("pareto.png"), &title, &sweep.pareto)?;
+            pareto_svg = Some(svg);
+            Some(sweep)
+        }
+        None => None,
+    };
     let summary = Summary {
         cases,
         tree_fit,
@@ -362,6 +435,7 @@ pub fn run_report(
         occlusion,
         biomechanics,
         bite,
+        sweep,
     };
     write_atomic(
         &out.join("summary.json"),
@@ -378,7 +452,10 @@ pub fn run_report(
         );
     }
     write_atomic(&out.join("distances.csv"), &csv)?;
-    write_atomic(&out.join("index.html"), html(&summary, &plots, &maps))?;
+    write_atomic(
+        &out.join("index.html"),
+        html(&summary, &plots, &maps, pareto_svg.as_deref()),
+    )?;
     progress("done", total, total);
     Ok(summary)
 }
@@ -390,7 +467,12 @@ fn escape(s: &str) -> String {
 }
 
 /// The self-contained page: tables and the plots inlined as SVG (the files beside it are linked).
-fn html(s: &Summary, plots: &[(String, String)], maps: &[(String, String)]) -> String {
+fn html(
+    s: &Summary,
+    plots: &[(String, String)],
+    maps: &[(String, String)],
+    pareto: Option<&str>,
+) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
@@ -542,6 +624,38 @@ adjacent pair, one series per algorithm. <a href=\"{0}.png\">PNG</a> · \
             if r.passes() { "yes" } else { "no" }
         );
     }
-    h.push_str("</table>\n</body></html>\n");
+    h.push_str("</table>\n");
+    if let (Some(sw), Some(svg)) = (&s.sweep, pareto) {
+        let _ = write!(
+            h,
+            "<h2>Exact contact: run time against error (<code>orthosim bench --sweep</code>)</h2>\n\
+<p>Normal case at {} vertices per tooth ({} triangles), {} near-contact pair steps, median of {} \
+passes on one core; errors are the exact gap or penetration of the meshes at the reported contact.</p>\n\
+<table><tr><th>tolerance mm</th><th>µs per pair</th><th>range</th><th>contacts</th><th>max error mm</th>\
+<th>mean error mm</th><th>false negatives</th></tr>\n",
+            sw.vertices, sw.triangles_per_tooth, sw.pairs, sw.passes
+        );
+        for p in &sw.pareto {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{:.1}</td><td>{:.1}–{:.1}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td></tr>",
+                p.tolerance_mm,
+                p.us_per_pair,
+                p.range_us[0],
+                p.range_us[1],
+                p.contacts,
+                p.max_error_mm,
+                p.mean_error_mm,
+                p.false_negatives
+            );
+        }
+        let body = svg.find("<svg").map_or(svg, |i| &svg[i..]);
+        let _ = writeln!(
+            h,
+            "</table>\n<figure>{body}<figcaption>Run time and largest error per tolerance \
+(<a href=\"pareto.png\">PNG</a>, <a href=\"pareto.svg\">SVG</a>)</figcaption></figure>"
+        );
+    }
+    h.push_str("</body></html>\n");
     h
 }

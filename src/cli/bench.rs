@@ -33,6 +33,10 @@ pub struct BenchArgs {
     /// vertices, about 20,000 triangles per tooth) or a number of vertices per tooth.
     #[arg(long, default_value = "default")]
     pub resolution: BenchResolution,
+    /// Run time against error instead: the exact stage on the near-contact set at tolerances
+    /// 0.001, 0.002, 0.005, 0.01, 0.02 and 0.05 mm (the pareto table).
+    #[arg(long)]
+    pub sweep: bool,
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -81,6 +85,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
     )?;
     let pairs = args.pairs as usize;
     let near = bench::near_contact_pairs(&teeth, pairs, args.seed);
+    if args.sweep {
+        return sweep(&teeth, &near, args.json, progress);
+    }
     let stress = bench::stress_pairs(&teeth, pairs, args.seed);
     let bar = |done: usize, total: usize| {
         if progress {
@@ -167,6 +174,79 @@ pub fn run(args: BenchArgs) -> Result<()> {
         bite.excursion_ms[0],
         bite.excursion_ms[1]
     );
+    Ok(())
+}
+
+/// Passes timed per tolerance in `--sweep`.
+const SWEEP_PASSES: usize = 3;
+
+/// `bench --sweep`: the pareto table of the exact stage.
+fn sweep(
+    teeth: &[bench::BenchTooth],
+    near: &[(
+        usize,
+        usize,
+        orthosim::collision::Motion,
+        orthosim::collision::Motion,
+    )],
+    json: bool,
+    progress: bool,
+) -> Result<()> {
+    let triangles = teeth
+        .iter()
+        .map(|t| t.shape.geometry.mesh.triangles.len())
+        .sum::<usize>()
+        / teeth.len().max(1);
+    let bar = |done: usize| {
+        if progress {
+            eprint!("\rsweeping: pass {done}/{SWEEP_PASSES}          ");
+            if done == SWEEP_PASSES {
+                eprintln!();
+            }
+        }
+    };
+    let pareto = bench::sweep(teeth, near, &bench::SWEEP_TOLERANCES_MM, SWEEP_PASSES, &bar);
+    if json {
+        #[derive(serde::Serialize)]
+        struct Output<'a> {
+            pairs: usize,
+            triangles_per_tooth: usize,
+            passes: usize,
+            pareto: &'a [bench::ParetoPoint],
+        }
+        return print_json(&Output {
+            pairs: near.len(),
+            triangles_per_tooth: triangles,
+            passes: SWEEP_PASSES,
+            pareto: &pareto,
+        });
+    }
+    println!(
+        "exact stage, {} near-contact pair steps, {triangles} triangles per tooth (median of {SWEEP_PASSES} passes)",
+        near.len()
+    );
+    println!(
+        "{:>12} {:>10} {:>17} {:>9} {:>13} {:>14} {:>9}",
+        "tolerance mm",
+        "µs/pair",
+        "range",
+        "contacts",
+        "max error mm",
+        "mean error mm",
+        "false neg"
+    );
+    for p in &pareto {
+        println!(
+            "{:>12} {:>10.1} {:>17} {:>9} {:>13.4} {:>14.4} {:>9}",
+            p.tolerance_mm,
+            p.us_per_pair,
+            format!("{:.1}–{:.1}", p.range_us[0], p.range_us[1]),
+            p.contacts,
+            p.max_error_mm,
+            p.mean_error_mm,
+            p.false_negatives
+        );
+    }
     Ok(())
 }
 

@@ -32,6 +32,33 @@ pub struct ReportArgs {
     /// Most steps per run.
     #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     pub max_steps: u64,
+    /// Resolution of the exact stage's run time against error (`bench --sweep` on the normal
+    /// case): `high` (10,100 vertices per tooth), a number of vertices per tooth, or `none`.
+    #[arg(long, default_value = "high")]
+    pub sweep: SweepAt,
+    /// Near-contact pair steps of that sweep.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub sweep_pairs: u64,
+}
+
+/// `report --sweep`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SweepAt(Option<u32>);
+
+impl std::str::FromStr for SweepAt {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "none" => Ok(Self(None)),
+            "high" => Ok(Self(Some(10_100))),
+            _ => match s.parse::<u32>() {
+                Ok(n) if (20..=200_000).contains(&n) => Ok(Self(Some(n))),
+                _ => Err(format!(
+                    "'{s}': use high, none or a number of vertices per tooth (20–200000)"
+                )),
+            },
+        }
+    }
 }
 
 /// Runs the report and says where it is.
@@ -48,6 +75,8 @@ pub fn run(args: ReportArgs) -> Result<()> {
         cache: args.trees.cache(),
         settings: MovementSettings::default(),
         max_steps: args.max_steps,
+        sweep_vertices: args.sweep.0,
+        sweep_pairs: args.sweep_pairs as usize,
     };
     let progress = progress_wanted();
     let bar = |what: &str, done: usize, total: usize| {

@@ -366,6 +366,120 @@ fn measure(
     }
 }
 
+/// Tolerances of `orthosim bench --sweep` (mm).
+pub const SWEEP_TOLERANCES_MM: [f64; 6] = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05];
+
+/// One tolerance of the sweep: what the exact stage costs and how close it leaves the teeth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ParetoPoint {
+    /// Largest gap the exact stage may leave at a reported contact (mm).
+    pub tolerance_mm: f64,
+    /// Median over the timed passes of the mean time per pair query (µs, one core).
+    pub us_per_pair: f64,
+    /// Fastest and slowest pass (µs per pair).
+    pub range_us: [f64; 2],
+    /// Contacts reported.
+    pub contacts: usize,
+    /// Largest |gap or penetration| of the meshes at the reported contacts (mm).
+    pub max_error_mm: f64,
+    /// Mean of those (mm).
+    pub mean_error_mm: f64,
+    /// Steps whose meshes touch or overlap at the start or end pose that report no contact.
+    pub false_negatives: usize,
+}
+
+/// Run time against error: the exact stage at each of `tolerances` (mm) on `pairs`, timed over
+/// `passes` passes interleaved across the tolerances (so a machine's drift spreads over all of
+/// them) after one untimed pass each; `done(k)` after each timed pass over all tolerances.
+///
+/// The error of a contact is the exact gap or penetration of the meshes at the reported time,
+/// from [`mesh_separation`], independent of the exact stage; steps that start interpenetrating
+/// are left out of it (as in [`run`]). A false negative is a step whose meshes touch or overlap
+/// at its start or end pose (by the same exact separation) that reports no contact; a step that
+/// touches only in between is not counted, so the count is a lower bound on misses (the oracle
+/// tests check the rest against parry3d).
+pub fn sweep(
+    teeth: &[BenchTooth],
+    pairs: &[(usize, usize, Motion, Motion)],
+    tolerances: &[f64],
+    passes: usize,
+    done: &dyn Fn(usize),
+) -> Vec<ParetoPoint> {
+    let gaps = |end: bool| -> Vec<f32> {
+        pairs
+            .iter()
+            .map(|&(i, j, ma, mb)| {
+                let (pa, pb) = if end {
+                    (ma.end, mb.end)
+                } else {
+                    (ma.start, mb.start)
+                };
+                exact_gap(&teeth[i], &pa, &teeth[j], &pb)
+            })
+            .collect()
+    };
+    let (start_gap, end_gap) = (gaps(false), gaps(true));
+    let run_all = |tolerance: f64, out: &mut Vec<Option<PairContact>>| {
+        out.clear();
+        out.extend(pairs.iter().map(|&(i, j, ma, mb)| {
+            super::narrow_phase::exact::query_with(
+                &body(&teeth[i], ma),
+                &body(&teeth[j], mb),
+                tolerance as f32,
+            )
+        }));
+    };
+    let mut results: Vec<Vec<Option<PairContact>>> = vec![Vec::new(); tolerances.len()];
+    for (k, &tol) in tolerances.iter().enumerate() {
+        run_all(tol, &mut results[k]);
+    }
+    let mut times = vec![Vec::with_capacity(passes); tolerances.len()];
+    for pass in 0..passes.max(1) {
+        for (k, &tol) in tolerances.iter().enumerate() {
+            let start = Instant::now();
+            run_all(tol, &mut results[k]);
+            times[k].push(start.elapsed().as_secs_f64() * 1e6 / pairs.len().max(1) as f64);
+        }
+        done(pass + 1);
+    }
+    tolerances
+        .iter()
+        .zip(results)
+        .zip(times)
+        .map(|((&tol, found), mut t)| {
+            t.sort_by(f64::total_cmp);
+            let mut errors = Vec::new();
+            let mut false_negatives = 0;
+            for (p, r) in found.iter().enumerate() {
+                let (i, j, ma, mb) = pairs[p];
+                match r {
+                    None if start_gap[p] <= 0.0 || end_gap[p] <= 0.0 => false_negatives += 1,
+                    None => {}
+                    Some(c) if start_gap[p] >= 0.0 => {
+                        let at = c.time_of_contact;
+                        let gap = exact_gap(&teeth[i], &ma.at(at), &teeth[j], &mb.at(at));
+                        errors.push(gap.abs() as f64);
+                    }
+                    Some(_) => {}
+                }
+            }
+            ParetoPoint {
+                tolerance_mm: tol,
+                us_per_pair: t[t.len() / 2],
+                range_us: [t[0], t[t.len() - 1]],
+                contacts: found.iter().filter(|r| r.is_some()).count(),
+                max_error_mm: errors.iter().copied().fold(0.0, f64::max),
+                mean_error_mm: if errors.is_empty() {
+                    0.0
+                } else {
+                    errors.iter().sum::<f64>() / errors.len() as f64
+                },
+                false_negatives,
+            }
+        })
+        .collect()
+}
+
 /// Mean time of one collision step (broad phase + continuous narrow phase) with every tooth moving
 /// by a small random motion (up to 0.05 mm and 0.5°), over `steps` steps (µs).
 pub fn full_mouth_step(teeth: &[BenchTooth], steps: usize, seed: u64) -> f64 {

@@ -341,6 +341,48 @@ fn bench_reports_every_method_with_no_false_negatives() {
 }
 
 #[test]
+fn bench_sweep_prints_run_time_against_error() {
+    let out = succeed(&[
+        "bench",
+        "--sweep",
+        "--pairs",
+        "40",
+        "--tree",
+        "octree",
+        "--no-cache",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["pairs"], 40);
+    let pareto = v["pareto"].as_array().unwrap();
+    let tolerances: Vec<f64> = pareto
+        .iter()
+        .map(|p| p["tolerance_mm"].as_f64().unwrap())
+        .collect();
+    let expected = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05];
+    assert_eq!(tolerances.len(), expected.len());
+    for (t, e) in tolerances.iter().zip(expected) {
+        assert!((t - e).abs() < 1e-6, "{t} for {e}");
+    }
+    let mut contacts = 0;
+    for p in pareto {
+        assert!(p["us_per_pair"].as_f64().unwrap() > 0.0, "{p}");
+        assert_eq!(p["false_negatives"], 0, "{p}");
+        let tol = p["tolerance_mm"].as_f64().unwrap();
+        assert!(
+            p["max_error_mm"].as_f64().unwrap() <= tol * 1.01 + 1e-6,
+            "{p}"
+        );
+        // A looser tolerance stops sooner, never later: it finds every contact a tighter one
+        // finds.
+        let c = p["contacts"].as_u64().unwrap();
+        assert!(c >= contacts, "{p}");
+        contacts = c;
+    }
+    assert!(contacts > 0);
+}
+
+#[test]
 fn simulate_reports_the_contract_keys() {
     let out = succeed(&[
         "simulate",
@@ -504,6 +546,10 @@ fn report_writes_every_file_its_page_refers_to() {
         "--fit-depths",
         "3",
         "--no-cache",
+        "--sweep",
+        "400",
+        "--sweep-pairs",
+        "24",
     ]);
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
     let mut refs = Vec::new();
@@ -521,6 +567,8 @@ fn report_writes_every_file_its_page_refers_to() {
         "occlusion_lower.png",
         "occlusion_upper.svg",
         "occlusion_lower.svg",
+        "pareto.png",
+        "pareto.svg",
     ] {
         assert!(refs.iter().any(|r| r == f), "index.html refers to {f}");
     }
@@ -528,7 +576,12 @@ fn report_writes_every_file_its_page_refers_to() {
         let len = std::fs::metadata(dir.join(r)).map(|m| m.len()).unwrap_or(0);
         assert!(len > 0, "{r} missing or empty");
     }
-    for png in ["case3.png", "occlusion_upper.png", "occlusion_lower.png"] {
+    for png in [
+        "case3.png",
+        "occlusion_upper.png",
+        "occlusion_lower.png",
+        "pareto.png",
+    ] {
         let png = std::fs::read(dir.join(png)).unwrap();
         assert_eq!(&png[..4], b"\x89PNG");
     }
@@ -547,6 +600,19 @@ fn report_writes_every_file_its_page_refers_to() {
             <= 0.01
     );
     assert_eq!(v["bite"]["stable"], true, "{}", v["bite"]);
+    let sweep = &v["sweep"];
+    assert_eq!(sweep["vertices"], 400, "{sweep}");
+    let pareto = sweep["pareto"].as_array().unwrap();
+    assert_eq!(pareto.len(), 6, "{sweep}");
+    for p in pareto {
+        let tol = p["tolerance_mm"].as_f64().unwrap();
+        assert!(p["us_per_pair"].as_f64().unwrap() > 0.0, "{p}");
+        assert!(
+            p["max_error_mm"].as_f64().unwrap() <= tol * 1.01 + 1e-6,
+            "{p}"
+        );
+        assert_eq!(p["false_negatives"], 0, "{p}");
+    }
     assert_eq!(
         v["biomechanics"]["rows"].as_array().map(|r| r.len()),
         Some(16)

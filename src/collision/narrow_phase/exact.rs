@@ -58,6 +58,10 @@
 //! meeting leaves), as in the flat search. The directional step descends the same way, a node
 //! pair being left closed when its plain bound or its drift along the direction already allows
 //! the step. All node bounds are computed in f32 and lowered by far more than their rounding.
+//! Once the motion is under way (t > 0) the teeth cannot interpenetrate, so the hierarchical
+//! search stops at the first triangle pair within the tolerance and reports it: its gap is within
+//! the tolerance, the true least gap lies between half the tolerance and it, and the time is the
+//! same conservative one (at t = 0 it searches for the least distance, which may be 0).
 //!
 //! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
 

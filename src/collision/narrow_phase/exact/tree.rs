@@ -299,20 +299,29 @@ impl Search<'_, '_> {
     /// The least distance between the candidate triangles of the two teeth (first tooth's frame),
     /// searched nearest node pairs first and pruned by the best so far, which starts at the
     /// distance of `first` (the previous step's nearest pair): the distance, its points and pair.
-    fn nearest(&mut self, first: Option<(u32, u32)>, axis: Vec3) -> (f32, Vec3, Vec3, (u32, u32)) {
+    /// The search ends early at the first pair found within `enough` (that pair is returned).
+    fn nearest(
+        &mut self,
+        first: Option<(u32, u32)>,
+        axis: Vec3,
+        enough: f32,
+    ) -> (f32, Vec3, Vec3, (u32, u32)) {
         self.set_axis(axis);
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO, (0, 0));
         if let Some((x, y)) = first {
             let (tx, ty) = (self.tri_a(x), self.tri_b(y));
             let p = closest_points_facing_triangles(&tx.v, &ty.v);
             best = (p.distance, p.on_first, p.on_second, (x, y));
+            if best.0 <= enough {
+                return best;
+            }
         }
         let mut stack = std::mem::take(&mut self.s.stack);
         stack.clear();
         if self.s.node_a.has(0) && self.s.node_b.has(0) {
             stack.push((0.0, 0, 0));
         }
-        while let Some((lb, na, nb)) = stack.pop() {
+        'search: while let Some((lb, na, nb)) = stack.pop() {
             if lb >= best.0 {
                 continue;
             }
@@ -336,6 +345,10 @@ impl Search<'_, '_> {
                         let p = closest_points_facing_triangles(&tx.v, &ty.v);
                         if p.distance < best.0 {
                             best = (p.distance, p.on_first, p.on_second, (i, j));
+                            if best.0 <= enough {
+                                stack.clear();
+                                break 'search;
+                            }
                         }
                     }
                 }
@@ -561,7 +574,13 @@ fn advance_with(
             rel,
             axis: Vec3::X,
         };
-        let (d, qa, qb, pair) = search.nearest(nearest, axis);
+        // After the start of the motion the teeth cannot interpenetrate (no leaf pair met
+        // before the earliest leaf time, and each step keeps half the tolerance), so any pair
+        // within the tolerance is a contact to report and the search stops at the first one
+        // found. At the start they may already interpenetrate, which only the least distance
+        // (0) shows.
+        let enough = if t > 0.0 { tol as f32 } else { -1.0 };
+        let (d, qa, qb, pair) = search.nearest(nearest, axis, enough);
         if !d.is_finite() {
             return None;
         }
