@@ -61,54 +61,71 @@ where
             lo = lo.min(x_lo);
             hi = hi.max(x_hi);
         }
-        let mut chart = ChartBuilder::on(area)
-            .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d((x_lo..x_hi).log_scale(), (lo..hi).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("tolerance (mm)")
-            .y_desc(y_desc)
-            .x_label_formatter(&|x| format!("{x}"))
-            .y_label_formatter(&|y| format!("{y:.3}"))
-            .label_style((font(), 12))
-            .axis_desc_style((font(), 13))
-            .draw()
-            .map_err(err)?;
-        if k == 1 {
-            chart
-                .draw_series(LineSeries::new(
-                    [(x_lo, x_lo), (x_hi, x_hi)],
-                    BLACK.stroke_width(1),
-                ))
-                .map_err(err)?
-                .label("error = tolerance")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
-        }
         let line: Vec<(f64, f64)> = tol
             .iter()
             .zip(&values)
             .filter(|(_, v)| **v > 0.0)
             .map(|(t, v)| (*t, *v))
             .collect();
-        chart
-            .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-            .map_err(err)?
-            .label(if k == 0 { "run time" } else { "max error" })
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
-        chart
-            .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
-            .map_err(err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font((font(), 12))
-            .draw()
-            .map_err(err)?;
+        // The two panels' charts differ in type (linear and log time axis), so the drawing
+        // common to both is written once here.
+        macro_rules! finish {
+            ($chart:ident, $y_fmt:expr) => {
+                $chart
+                    .configure_mesh()
+                    .x_desc("tolerance (mm)")
+                    .y_desc(y_desc)
+                    .x_label_formatter(&|x| format!("{x}"))
+                    .y_label_formatter(&$y_fmt)
+                    .label_style((font(), 12))
+                    .axis_desc_style((font(), 13))
+                    .draw()
+                    .map_err(err)?;
+                if k == 1 {
+                    $chart
+                        .draw_series(LineSeries::new(
+                            [(x_lo, x_lo), (x_hi, x_hi)],
+                            BLACK.stroke_width(1),
+                        ))
+                        .map_err(err)?
+                        .label("error = tolerance")
+                        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+                }
+                $chart
+                    .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
+                    .map_err(err)?
+                    .label(if k == 0 { "run time" } else { "max error" })
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
+                $chart
+                    .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                    .map_err(err)?;
+                $chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperRight)
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK)
+                    .label_font((font(), 12))
+                    .draw()
+                    .map_err(err)?;
+            };
+        }
+        let mut builder = ChartBuilder::on(area);
+        builder
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(64);
+        if k == 0 {
+            // Run times span less than a decade: a linear axis from 0 labels them.
+            let mut chart = builder
+                .build_cartesian_2d((x_lo..x_hi).log_scale(), 0.0..hi / 1.5 * 1.15)
+                .map_err(err)?;
+            finish!(chart, |y: &f64| format!("{y:.0}"));
+        } else {
+            let mut chart = builder
+                .build_cartesian_2d((x_lo..x_hi).log_scale(), (lo..hi).log_scale())
+                .map_err(err)?;
+            finish!(chart, |y: &f64| format!("{y:.3}"));
+        }
     }
     root.present().map_err(err)
 }
