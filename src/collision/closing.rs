@@ -22,7 +22,7 @@ use super::{
     motion::Motion,
     narrow_phase::{Body, Method, PairContact, spheres},
 };
-use crate::geometry::{Pose, mesh_separation};
+use crate::geometry::{NearContact, Pose, crossing_triangles, mesh_penetration_near};
 
 /// A distance must fall by more than this (mm per step) to count as approaching.
 pub const APPROACH_MM: f32 = 1e-7;
@@ -90,6 +90,36 @@ pub fn approaching(method: Method, a: &Body, b: &Body, contact: &PairContact, t:
     }
 }
 
+/// Distance (mm) within which triangles count as meeting the other surface in [`end_gap`]: far
+/// above the rounding of a triangle pair's closest points, far below any depth that matters.
+const MEETING_MM: f32 = 1e-4;
+
+/// Minus the depth of the meshes' overlap at the end of the step, the same estimate as
+/// [`crate::geometry::mesh_separation`]'s, found from where the surfaces meet: the walk over the
+/// part of each surface inside the other ([`mesh_penetration_near`], which also finds a solid
+/// wholly inside the other) instead of sampling both whole meshes. 0 when they do not overlap,
+/// whatever their gap (only an overlap can deepen).
+fn end_gap(a: &Body, b: &Body) -> f32 {
+    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+    let (pa, pb) = (&a.motion.end, &b.motion.end);
+    let (near_a, near_b) = crossing_triangles(ga.mesh_ref(), pa, gb.mesh_ref(), pb, MEETING_MM);
+    let (depth, _, _) = mesh_penetration_near(
+        NearContact {
+            mesh: ga.mesh_ref(),
+            stars: &ga.stars,
+            near: &near_a,
+        },
+        pa,
+        NearContact {
+            mesh: gb.mesh_ref(),
+            stars: &gb.stars,
+            near: &near_b,
+        },
+        pb,
+    );
+    -depth
+}
+
 /// For a contact already touching at the start of the step: whether the overlap is deeper at the
 /// end of the step than at its start (exact: the meshes overlap at the end more than the
 /// contact's depth; continuous and spheres: the deepest overlap of leaf spheres grows, or
@@ -99,13 +129,7 @@ pub fn deepens(method: Method, a: &Body, b: &Body, contact: &PairContact) -> boo
     let (ma, mb) = (&a.motion, &b.motion);
     match method {
         Method::Exact => {
-            let end = mesh_separation(
-                a.shape.geometry.mesh_ref(),
-                &ma.end,
-                b.shape.geometry.mesh_ref(),
-                &mb.end,
-            )
-            .signed_gap();
+            let end = end_gap(a, b);
             end < 0.0 && end < -contact.depth_mm - DEEPEN_MM
         }
         Method::Continuous | Method::Spheres => {

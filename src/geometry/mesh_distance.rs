@@ -566,6 +566,32 @@ mod tooth_tests {
             if whole.0 > 0.0 {
                 assert_eq!((walked.1, walked.2), (whole.1, whole.2), "case {case}");
             }
+            // The hierarchy search lists every meeting triangle (and only near ones).
+            let (cross_a, cross_b) = crate::geometry::crossing_triangles(
+                a.mesh_ref(),
+                &pose_a,
+                b.mesh_ref(),
+                &pose_b,
+                1e-4,
+            );
+            assert!(near_a.iter().all(|t| cross_a.contains(t)), "case {case}");
+            assert!(near_b.iter().all(|t| cross_b.contains(t)), "case {case}");
+            for &t in cross_a.iter().take(12) {
+                let ta = a
+                    .mesh
+                    .triangle(t as usize)
+                    .map(|v| pose_a.transform_point(v));
+                let nearest = (0..b.mesh.triangles.len())
+                    .map(|j| {
+                        let tb = b.mesh.triangle(j).map(|v| pose_b.transform_point(v));
+                        crate::geometry::closest_points_triangle_triangle(&ta, &tb).distance
+                    })
+                    .fold(f32::INFINITY, f32::min);
+                assert!(
+                    nearest <= 2e-4,
+                    "case {case}: triangle {t} is {nearest} mm away"
+                );
+            }
             deep += (whole.0 > 0.5) as usize;
         }
         assert!(deep > 20, "{deep} deep overlaps");

@@ -8,6 +8,7 @@ mod aabb;
 mod bvh;
 mod closest;
 pub(crate) mod columns;
+mod crossing;
 pub(crate) mod decimate;
 pub(crate) mod interval;
 pub(crate) mod lanes;
@@ -30,6 +31,7 @@ pub use closest::{
     triangle_plane_gap, triangles_intersect,
 };
 pub(crate) use columns::{Columns, LocalLines};
+pub use crossing::crossing_triangles;
 pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
 pub use mat6::{Mat6, Vec6, halves, vec6};
 pub use mesh_distance::{

@@ -390,3 +390,65 @@ fn scan_resolution_keeps_the_guarantees() {
     assert_eq!(t.late, 0, "{t:?}");
     assert_eq!(t.gap_errors, 0, "{t:?}");
 }
+
+/// Whether an exact contact deepens over the step is judged from where the meshes meet at its end
+/// (the walk over the part of each surface inside the other): the same answer as the whole-mesh
+/// separation gives, for teeth that end apart, touching, or overlapping by up to 0.6 mm, with start
+/// depths on either side of the end's.
+#[test]
+fn exact_deepening_is_judged_from_where_the_meshes_meet() {
+    use orthosim::collision::{PairContact, closing::deepens};
+    use orthosim::geometry::mesh_separation;
+    let pairs = teeth(
+        TreeMethod::Octree,
+        4,
+        &[(11, 21), (11, 12), (13, 14), (16, 15)],
+    );
+    let mut rng = Rng(0xdee9);
+    let (mut deeper, mut not) = (0, 0);
+    for k in 0..160 {
+        let (a, b) = &pairs[k % pairs.len()];
+        let towards = (b.rest.translation - a.rest.translation).normalize();
+        let start = rng.perturb(&a.rest, 1.0, 0.1);
+        // From 0.3 mm apart to 0.6 mm further in, along the line between the teeth.
+        let end = Pose::new(
+            start.rotation,
+            start.translation + towards * (rng.uniform() * 0.9 - 0.3) * 1.5,
+        );
+        let (ma, mb) = (Motion { start, end }, Motion::still(b.rest));
+        let end_gap = mesh_separation(
+            a.shape.geometry.mesh_ref(),
+            &end,
+            b.shape.geometry.mesh_ref(),
+            &b.rest,
+        )
+        .signed_gap();
+        let depth_mm = rng.uniform() * 0.4 - 0.1;
+        let contact = PairContact {
+            time_of_contact: 0.0,
+            points: [start.translation; 2],
+            normal: towards,
+            depth_mm,
+            leaf_pairs: Vec::new(),
+        };
+        let expected = end_gap < 0.0 && end_gap < -depth_mm - 1e-6;
+        fn body(t: &TestTooth, m: Motion) -> Body<'_> {
+            Body {
+                shape: &t.shape,
+                circle: t.circle,
+                motion: m,
+            }
+        }
+        let got = deepens(Method::Exact, &body(a, ma), &body(b, mb), &contact);
+        assert_eq!(
+            got, expected,
+            "motion {k}: end gap {end_gap}, start depth {depth_mm}"
+        );
+        if got {
+            deeper += 1;
+        } else {
+            not += 1;
+        }
+    }
+    assert!(deeper > 20 && not > 20, "{deeper} deepen, {not} do not");
+}
