@@ -280,6 +280,41 @@ impl Search<'_, '_> {
         false
     }
 
+    /// Calls `f(tx, ty, pair, lb, between)` for each pair of triangles of leaves `na` (first
+    /// tooth) and `nb` (second) that lie in a meeting leaf pair: the placed triangles, their
+    /// numbers, a lower bound of their distance (bounding spheres and projections on `axis`) and
+    /// the distance between their centres. Stops when `f` returns false; returns whether every
+    /// pair was seen.
+    #[inline]
+    fn leaf_pairs(
+        &mut self,
+        na: u32,
+        nb: u32,
+        axis: Vec3,
+        mut f: impl FnMut(&PlacedTri, &PlacedTri, (u32, u32), f32, f32) -> bool,
+    ) -> bool {
+        let (ba, bb) = (self.ba, self.bb);
+        let (x, y) = (&ba.nodes[na as usize], &bb.nodes[nb as usize]);
+        for &i in ba.leaf_triangles(x) {
+            if !self.s.cand_a.has(i as usize) {
+                continue;
+            }
+            let tx = self.tri_a(i);
+            for &j in bb.leaf_triangles(y) {
+                if !self.meet(i, j) {
+                    continue;
+                }
+                let ty = self.tri_b(j);
+                let between = tx.centre.distance(ty.centre);
+                let lb = (between - tx.radius - ty.radius).max(tx.axis_gap(&ty, axis));
+                if !f(&tx, &ty, (i, j), lb, between) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// Child node pairs of (na, nb) that hold candidates on both sides (the larger node split).
     #[inline]
     fn children(&mut self, na: u32, nb: u32) -> [Option<(u32, u32)>; 2] {
@@ -321,36 +356,25 @@ impl Search<'_, '_> {
         if self.s.node_a.has(0) && self.s.node_b.has(0) {
             stack.push((0.0, 0, 0));
         }
-        'search: while let Some((lb, na, nb)) = stack.pop() {
+        while let Some((lb, na, nb)) = stack.pop() {
             if lb >= best.0 {
                 continue;
             }
             let (x, y) = (self.ba.nodes[na as usize], self.bb.nodes[nb as usize]);
             if x.is_leaf() && y.is_leaf() {
-                for &i in self.ba.leaf_triangles(&x) {
-                    if !self.s.cand_a.has(i as usize) {
-                        continue;
+                let finished = self.leaf_pairs(na, nb, axis, |tx, ty, pair, lb, between| {
+                    if lb >= best.0 || tx.gap_to(ty, between) >= best.0 {
+                        return true;
                     }
-                    let tx = self.tri_a(i);
-                    for &j in self.bb.leaf_triangles(&y) {
-                        if !self.meet(i, j) {
-                            continue;
-                        }
-                        let ty = self.tri_b(j);
-                        let between = tx.centre.distance(ty.centre);
-                        let lb = (between - tx.radius - ty.radius).max(tx.axis_gap(&ty, axis));
-                        if lb >= best.0 || tx.gap_to(&ty, between) >= best.0 {
-                            continue;
-                        }
-                        let p = closest_points_facing_triangles(&tx.v, &ty.v);
-                        if p.distance < best.0 {
-                            best = (p.distance, p.on_first, p.on_second, (i, j));
-                            if best.0 <= enough {
-                                stack.clear();
-                                break 'search;
-                            }
-                        }
+                    let p = closest_points_facing_triangles(&tx.v, &ty.v);
+                    if p.distance < best.0 {
+                        best = (p.distance, p.on_first, p.on_second, pair);
                     }
+                    best.0 > enough
+                });
+                if !finished {
+                    stack.clear();
+                    break;
                 }
                 continue;
             }
@@ -392,29 +416,18 @@ impl Search<'_, '_> {
                 continue;
             }
             if x.is_leaf() && y.is_leaf() {
-                for &i in self.ba.leaf_triangles(&x) {
-                    if !self.s.cand_a.has(i as usize) {
-                        continue;
+                self.leaf_pairs(na, nb, drift.n, |tx, ty, _, lb, between| {
+                    if allows(lb) >= step {
+                        return true;
                     }
-                    let tx = self.tri_a(i);
-                    for &j in self.bb.leaf_triangles(&y) {
-                        if !self.meet(i, j) {
-                            continue;
-                        }
-                        let ty = self.tri_b(j);
-                        let between = tx.centre.distance(ty.centre);
-                        let lb = (between - tx.radius - ty.radius).max(tx.axis_gap(&ty, drift.n));
-                        if allows(lb) >= step {
-                            continue;
-                        }
-                        let along = drift.step(&tx, &ty);
-                        if along >= step || allows(tx.gap_to(&ty, between)) >= step {
-                            continue;
-                        }
-                        let d = closest_points_facing_triangles(&tx.v, &ty.v).distance;
-                        step = step.min(along.max(allows(d))).max(plain);
+                    let along = drift.step(tx, ty);
+                    if along >= step || allows(tx.gap_to(ty, between)) >= step {
+                        return true;
                     }
-                }
+                    let d = closest_points_facing_triangles(&tx.v, &ty.v).distance;
+                    step = step.min(along.max(allows(d))).max(plain);
+                    true
+                });
                 continue;
             }
             for (ca, cb) in self.children(na, nb).into_iter().flatten() {
