@@ -5,7 +5,9 @@
 //! teeth, an extra run under the `ipr` response (continuous) for the interproximal reduction, and
 //! the occlusal contacts of the exact run's final poses with the bite closed again (the upper arch
 //! lowered by the case's bite opening). Once: the sphere-tree fit table (octree and medial at the
-//! asked depths, on the `normal` case) and the Bolton analysis (anatomy widths, `normal` arches).
+//! asked depths, on the `normal` case) and the Bolton analysis (anatomy widths, `normal` arches);
+//! unless turned off, the exact stage's run time against error on the `normal` case's teeth at the
+//! asked resolution (`orthosim bench --sweep`).
 
 use std::{collections::BTreeMap, fmt::Write as _, path::Path};
 
@@ -65,9 +67,6 @@ pub struct SweepSummary {
     pub pareto: Vec<ParetoPoint>,
 }
 
-/// Passes timed per tolerance in the report's sweep.
-const SWEEP_PASSES: usize = 3;
-
 /// The sweep of the normal case's teeth at `vertices` per tooth.
 fn sweep_summary(opts: &ReportOptions, vertices: u32) -> Result<SweepSummary, AnalysisError> {
     let mut loaded = Case::resolve("normal")?;
@@ -79,7 +78,7 @@ fn sweep_summary(opts: &ReportOptions, vertices: u32) -> Result<SweepSummary, An
         &teeth,
         &near,
         &bench::SWEEP_TOLERANCES_MM,
-        SWEEP_PASSES,
+        bench::SWEEP_PASSES,
         &|_| {},
     );
     Ok(SweepSummary {
@@ -90,7 +89,7 @@ fn sweep_summary(opts: &ReportOptions, vertices: u32) -> Result<SweepSummary, An
             .sum::<usize>()
             / teeth.len().max(1),
         pairs: near.len(),
-        passes: SWEEP_PASSES,
+        passes: bench::SWEEP_PASSES,
         pareto,
     })
 }

@@ -177,9 +177,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Passes timed per tolerance in `--sweep`.
-const SWEEP_PASSES: usize = 3;
-
 /// `bench --sweep`: the pareto table of the exact stage.
 fn sweep(
     teeth: &[bench::BenchTooth],
@@ -197,15 +194,16 @@ fn sweep(
         .map(|t| t.shape.geometry.mesh.triangles.len())
         .sum::<usize>()
         / teeth.len().max(1);
+    let passes = bench::SWEEP_PASSES;
     let bar = |done: usize| {
         if progress {
-            eprint!("\rsweeping: pass {done}/{SWEEP_PASSES}          ");
-            if done == SWEEP_PASSES {
+            eprint!("\rsweeping: pass {done}/{passes}          ");
+            if done == passes {
                 eprintln!();
             }
         }
     };
-    let pareto = bench::sweep(teeth, near, &bench::SWEEP_TOLERANCES_MM, SWEEP_PASSES, &bar);
+    let pareto = bench::sweep(teeth, near, &bench::SWEEP_TOLERANCES_MM, passes, &bar);
     if json {
         #[derive(serde::Serialize)]
         struct Output<'a> {
@@ -217,12 +215,12 @@ fn sweep(
         return print_json(&Output {
             pairs: near.len(),
             triangles_per_tooth: triangles,
-            passes: SWEEP_PASSES,
+            passes,
             pareto: &pareto,
         });
     }
     println!(
-        "exact stage, {} near-contact pair steps, {triangles} triangles per tooth (median of {SWEEP_PASSES} passes)",
+        "exact stage, {} near-contact pair steps, {triangles} triangles per tooth (median of {passes} passes)",
         near.len()
     );
     println!(

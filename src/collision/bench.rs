@@ -366,6 +366,9 @@ fn measure(
     }
 }
 
+/// Timed passes per tolerance of `orthosim bench --sweep` and of the report's sweep.
+pub const SWEEP_PASSES: usize = 3;
+
 /// Tolerances of `orthosim bench --sweep` (mm).
 pub const SWEEP_TOLERANCES_MM: [f64; 6] = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05];
 
