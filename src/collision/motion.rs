@@ -146,6 +146,7 @@ fn dquat(q: Quat) -> DQuat {
 
 /// Per-thread scratch for per-node values computed once per query: a value is valid when its stamp
 /// equals the current query's stamp, so nothing is cleared or allocated between queries.
+#[derive(Default)]
 pub(crate) struct NodeCache<T: Copy + Default> {
     values: Vec<T>,
     stamps: Vec<u32>,

@@ -3,9 +3,9 @@
 //! walk the part of each surface inside the other, so that the depth of an overlap is found
 //! without sampling the whole meshes.
 
-use glam::{Mat3, Vec3};
-
-use super::{aabb::Aabb, closest::closest_points_triangle_triangle, mesh_distance::MeshRef};
+use super::aabb::Aabb;
+use super::closest::closest_points_triangle_triangle;
+use super::mesh_distance::{InFirst, MeshRef};
 use crate::geometry::Pose;
 
 /// The triangles of `a` (posed by `pose_a`) and of `b` (by `pose_b`) within `within` mm (≥ 0) of
@@ -25,14 +25,9 @@ pub fn crossing_triangles(
     if a.bvh.nodes.is_empty() || b.bvh.nodes.is_empty() {
         return (near_a, near_b);
     }
-    // Work in a's frame: b_in_a = pose_a⁻¹ ∘ pose_b.
-    let rel = pose_a.inverse().mul(pose_b);
-    let rot = Mat3::from_quat(rel.rotation);
-    let bbox = |node: u32| {
-        b.bvh.nodes[node as usize]
-            .aabb
-            .transformed(&rot, rel.translation)
-    };
+    // Work in a's frame.
+    let in_a = InFirst::new(pose_a, b, pose_b);
+    let bbox = |node: u32| in_a.node_box(node);
     let within = within.max(0.0);
     let reach = within * within;
     let mut stack: Vec<(u32, u32, Aabb)> = vec![(0, 0, bbox(0))];
@@ -46,7 +41,7 @@ pub fn crossing_triangles(
                 let ta = a.mesh.triangle(i as usize);
                 let box_a = Aabb::from_points(ta);
                 for &j in b.bvh.leaf_triangles(&node_b) {
-                    let tb: [Vec3; 3] = b.mesh.triangle(j as usize).map(|v| rel.transform_point(v));
+                    let tb = in_a.triangle(j);
                     if box_a.distance_squared(&Aabb::from_points(tb)) > reach {
                         continue;
                     }

@@ -34,6 +34,43 @@ pub struct MeshRef<'a> {
     pub bvh: &'a TriangleBvh,
 }
 
+/// The second mesh of a query seen from the first's frame (pose_a⁻¹ ∘ pose_b), where the
+/// hierarchy searches work: the first mesh's triangles and boxes as stored, the second's mapped.
+pub(super) struct InFirst<'a> {
+    mesh: MeshRef<'a>,
+    rel: Pose,
+    rot: Mat3,
+}
+
+impl<'a> InFirst<'a> {
+    /// `b` (posed by `pose_b`) in the frame of a mesh posed by `pose_a`.
+    pub(super) fn new(pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
+        let rel = pose_a.inverse().mul(pose_b);
+        Self {
+            mesh: b,
+            rel,
+            rot: Mat3::from_quat(rel.rotation),
+        }
+    }
+
+    /// Triangle `j`, mapped.
+    #[inline]
+    pub(super) fn triangle(&self, j: u32) -> [Vec3; 3] {
+        self.mesh
+            .mesh
+            .triangle(j as usize)
+            .map(|v| self.rel.transform_point(v))
+    }
+
+    /// The box of hierarchy node `node`, mapped (it holds the mapped node's triangles).
+    #[inline]
+    pub(super) fn node_box(&self, node: u32) -> Aabb {
+        self.mesh.bvh.nodes[node as usize]
+            .aabb
+            .transformed(&self.rot, self.rel.translation)
+    }
+}
+
 /// Result of [`mesh_separation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshSeparation {
@@ -75,14 +112,9 @@ pub fn closest_triangles(
     if a.bvh.nodes.is_empty() || b.bvh.nodes.is_empty() {
         return None;
     }
-    // Work in a's frame: b_in_a = pose_a⁻¹ ∘ pose_b.
-    let rel = pose_a.inverse().mul(pose_b);
-    let rot = Mat3::from_quat(rel.rotation);
-    let bbox = |node: u32| {
-        b.bvh.nodes[node as usize]
-            .aabb
-            .transformed(&rot, rel.translation)
-    };
+    // Work in a's frame.
+    let in_a = InFirst::new(pose_a, b, pose_b);
+    let bbox = |node: u32| in_a.node_box(node);
     let mut best: Option<(TrianglePair, usize, usize)> = None;
     let mut best_d2 = if max_distance.is_finite() {
         max_distance * max_distance
@@ -100,7 +132,7 @@ pub fn closest_triangles(
             for &i in a.bvh.leaf_triangles(&node_a) {
                 let ta = a.mesh.triangle(i as usize);
                 for &j in b.bvh.leaf_triangles(&node_b) {
-                    let tb = b.mesh.triangle(j as usize).map(|v| rel.transform_point(v));
+                    let tb = in_a.triangle(j);
                     if best.is_some() {
                         let lb = triangle_plane_gap(&ta, &tb);
                         if lb * lb > best_d2 {

@@ -321,6 +321,66 @@ fn report(
     contact
 }
 
+/// A search of the candidate triangle pairs, flat or hierarchical: what the advancement loop
+/// ([`advance_over`]) asks of it at each step.
+trait Candidates {
+    /// Places the second tooth's candidates at time `t` (`frame`).
+    fn place(&mut self, t: f64, frame: &Frame);
+    /// The least distance between the candidates now (the search may instead stop at the first
+    /// pair found within `enough`), measured first along `axis`: the gap and its closest points
+    /// (first tooth's frame); `None` when there are no candidates.
+    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, Vec3, Vec3)>;
+    /// How long the pair [`Self::least`] found stays apart along the drift's direction.
+    fn nearest_drift(&mut self, drift: &drift::Drift) -> f64;
+    /// The longest step, from `plain` (every pair allows it) up to `first`, that every candidate
+    /// pair allows: its own plain bound (distance less h, over μ) or its drift along the
+    /// direction.
+    fn extend(&mut self, drift: &drift::Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64;
+}
+
+/// The advancement loop from time `t`, the first search along `axis`: search, stop or step
+/// (plainly, then as far as the drift along the closest direction allows), until the contact
+/// is reported or the motion ends. `ids` are the candidate triangles of each tooth.
+fn advance_over(
+    ctx: &Settle,
+    mut t: f64,
+    mut axis: Vec3,
+    ids: [&[u32]; 2],
+    search: &mut impl Candidates,
+) -> Option<PairContact> {
+    let (a, b) = (ctx.a, ctx.b);
+    let motions = drift::Relative::new(&a.motion, &b.motion, b.shape.max_rho as f64);
+    for round in 0..=MAX_STEPS {
+        // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
+        let frame = relative(&a.motion, &b.motion, t);
+        search.place(t, &frame);
+        // After the start of the motion the teeth cannot interpenetrate (no leaf pair met
+        // before the earliest leaf time, and each step keeps half the tolerance), so any pair
+        // within the tolerance is a contact to report. At the start they may already
+        // interpenetrate, which only the least distance (0) shows.
+        let enough = if t > 0.0 { ctx.tol as f32 } else { -1.0 };
+        let (d, qa, qb) = search.least(axis, enough)?;
+        axis = (qb - qa).normalize_or(axis);
+        let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, ids, round == MAX_STEPS) {
+            Settled::Report(c) => return Some(c),
+            Settled::Stuck => return None,
+            Settled::Step { h, plain } => (h, plain),
+        };
+        let mut step = plain;
+        if let Some(drift) = motions.drift(t, frame.to_a, axis, &frame.rel, h) {
+            let first = search.nearest_drift(&drift).min(1.0 - t).max(plain);
+            if first > plain {
+                step = search.extend(&drift, ctx.mu, h, plain, first);
+            }
+        }
+        t += step;
+        if t >= 1.0 {
+            return None;
+        }
+    }
+    None
+}
+
 /// Both teeth at one time, seen from the first tooth.
 struct Frame {
     pose_a: crate::geometry::Pose,

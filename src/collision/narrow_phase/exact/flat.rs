@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
-use super::drift::Relative;
-use super::{Frame, MAX_STEPS, PlacedTri, Settle, Settled, relative};
+use super::drift::Drift;
+use super::{Candidates, Frame, PlacedTri, Settle, advance_over, relative};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::Body;
 use crate::collision::narrow_phase::lanes::Affine32;
@@ -18,6 +18,7 @@ const LIPSCHITZ_SLACK_MM: f64 = 1e-4;
 
 /// Per-thread scratch of the advancement: each mesh triangle's index among the candidates, the
 /// triangle pairs already listed (one bit per pair of candidates) and the candidate pairs.
+#[derive(Default)]
 struct Scratch {
     slot_a: NodeCache<u32>,
     slot_b: NodeCache<u32>,
@@ -44,18 +45,7 @@ struct Candidate {
 const KEEP_CANDIDATES: usize = 1 << 16;
 
 thread_local! {
-    static SCRATCH: std::cell::RefCell<Scratch> = const {
-        std::cell::RefCell::new(Scratch {
-            slot_a: NodeCache::new(),
-            slot_b: NodeCache::new(),
-            leaf_a: NodeCache::new(),
-            leaf_b: NodeCache::new(),
-            local_a: Vec::new(),
-            local_b: Vec::new(),
-            listed: Vec::new(),
-            candidates: Vec::new(),
-        })
-    };
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 /// Conservative advancement over the bodies' whole motion with flat candidate lists.
@@ -97,7 +87,7 @@ fn advance_with(
         listed,
         candidates,
     } = scratch;
-    let mut t = swept
+    let t = swept
         .leaf_times
         .iter()
         .map(|x| x.2)
@@ -200,22 +190,11 @@ fn advance_with(
         motion.speed_bound_of(ids.iter().flat_map(|&t| mesh.triangle(t as usize)))
     };
     let mu = (speed(&a.motion, ma, &ids_a) + speed(&b.motion, mb, &ids_b)) * (1.0 + 1e-6);
-    // The first tooth's candidate triangles as stored, the second's placed anew each step.
-    let place = |mesh: &crate::geometry::TriMesh, id: u32, map: Option<&Affine32>| {
-        let [p, q, r] = mesh.triangle(id as usize);
-        PlacedTri::new(match map {
-            Some(m) => [m.apply(p), m.apply(q), m.apply(r)],
-            None => [p, q, r],
-        })
-    };
     let tris_a: Vec<PlacedTri> = ids_a.iter().map(|&x| place(ma, x, None)).collect();
-    let mut tris_b: Vec<PlacedTri> = Vec::with_capacity(ids_b.len());
-    let motions = Relative::new(&a.motion, &b.motion, b.shape.max_rho as f64);
-    // The nearest pair of the previous step, measured first in the next, and the direction
-    // between its closest points (a's frame): projections on it bound most pairs near the contact.
-    // Before the first step, the direction between the nearest leaf pair's centres.
-    let mut nearest: Option<usize> = None;
-    let mut axis = order.first().map_or(Vec3::X, |&(_, k)| {
+    // The direction between the closest points of the previous step's nearest pair (a's frame):
+    // projections on it bound most pairs near the contact. Before the first step, the direction
+    // between the nearest leaf pair's centres.
+    let axis = order.first().map_or(Vec3::X, |&(_, k)| {
         let (i, j, _) = swept.leaf_times[k];
         let (sa, sb) = (ta.spheres[i as usize], tb.spheres[j as usize]);
         (start_rel.apply(sb.centre) - sa.centre).normalize_or(Vec3::X)
@@ -227,16 +206,55 @@ fn advance_with(
         tol,
         mu,
     };
-    for round in 0..=MAX_STEPS {
-        // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
-        let Frame {
-            pose_a,
-            pose_b,
-            to_a,
-            rel,
-        } = relative(&a.motion, &b.motion, t);
-        tris_b.clear();
-        tris_b.extend(ids_b.iter().map(|&y| place(mb, y, Some(&rel))));
+    let mut search = Flat {
+        tris_a,
+        tris_b: Vec::with_capacity(ids_b.len()),
+        ids_b: &ids_b,
+        mb,
+        candidates,
+        nearest: None,
+        t,
+        mu,
+    };
+    advance_over(&ctx, t, axis, [&ids_a, &ids_b], &mut search)
+}
+
+/// The first tooth's candidate triangle `id` as stored, or the second's mapped by `map`.
+fn place(mesh: &crate::geometry::TriMesh, id: u32, map: Option<&Affine32>) -> PlacedTri {
+    let [p, q, r] = mesh.triangle(id as usize);
+    PlacedTri::new(match map {
+        Some(m) => [m.apply(p), m.apply(q), m.apply(r)],
+        None => [p, q, r],
+    })
+}
+
+/// The flat search: every candidate pair looked at in each step.
+struct Flat<'x> {
+    /// The first tooth's candidate triangles as stored, the second's placed anew each step.
+    tris_a: Vec<PlacedTri>,
+    tris_b: Vec<PlacedTri>,
+    ids_b: &'x [u32],
+    mb: &'x crate::geometry::TriMesh,
+    candidates: &'x mut Vec<Candidate>,
+    /// The nearest pair of the previous step, measured first in the next.
+    nearest: Option<usize>,
+    /// The current time and the bound on the closing speed.
+    t: f64,
+    mu: f64,
+}
+
+impl Candidates for Flat<'_> {
+    fn place(&mut self, t: f64, frame: &Frame) {
+        self.t = t;
+        let (mb, rel) = (self.mb, frame.rel);
+        self.tris_b.clear();
+        self.tris_b
+            .extend(self.ids_b.iter().map(|&y| place(mb, y, Some(&rel))));
+    }
+
+    fn least(&mut self, axis: Vec3, _enough: f32) -> Option<(f32, Vec3, Vec3)> {
+        let (t, mu) = (self.t, self.mu);
+        let (tris_a, tris_b) = (&self.tris_a, &self.tris_b);
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
         let mut best_k = None;
         // No pair's distance shrinks faster than μ, so its last distance d, measured at t₀,
@@ -267,9 +285,10 @@ fn advance_with(
                 best_k = Some(k);
             }
         };
-        if nearest.is_none() {
+        if self.nearest.is_none() {
             // First step: the pair whose bounding spheres are nearest is measured first.
-            nearest = candidates
+            self.nearest = self
+                .candidates
                 .iter()
                 .enumerate()
                 .map(|(k, c)| {
@@ -279,54 +298,41 @@ fn advance_with(
                 .min_by(|x, y| x.0.total_cmp(&y.0))
                 .map(|x| x.1);
         }
+        let nearest = self.nearest;
         if let Some(k) = nearest {
-            look(k, &mut candidates[k]);
+            look(k, &mut self.candidates[k]);
         }
-        for (k, c) in candidates.iter_mut().enumerate() {
+        for (k, c) in self.candidates.iter_mut().enumerate() {
             if Some(k) != nearest {
                 look(k, c);
             }
         }
-        nearest = best_k;
+        self.nearest = best_k;
         let (d, qa, qb) = best;
-        axis = (qb - qa).normalize_or(axis);
-        if !d.is_finite() {
-            return None;
-        }
-        let frame = Frame {
-            pose_a,
-            pose_b,
-            to_a,
-            rel,
-        };
-        let last = round == MAX_STEPS;
-        let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, [&ids_a, &ids_b], last) {
-            Settled::Report(c) => return Some(c),
-            Settled::Stuck => return None,
-            Settled::Step { h, plain } => (h, plain),
-        };
-        let mut step = plain;
-        if let (Some(k), Some(drift)) = (nearest, motions.drift(t, to_a, axis, &rel, h)) {
-            let c = &candidates[k];
-            let first = drift.step(&tris_a[c.x as usize], &tris_b[c.y as usize]);
-            step = first.min(1.0 - t).max(plain);
-            for c in candidates.iter() {
-                if step <= plain {
-                    break;
-                }
-                // Pairs whose own distance bound already allows the step need no more.
-                let bound = c.d as f64 - mu * (t - c.t) - LIPSCHITZ_SLACK_MM;
-                if bound - h >= mu * step {
-                    continue;
-                }
-                let own = drift.step(&tris_a[c.x as usize], &tris_b[c.y as usize]);
-                step = step.min(own.max((bound - h) / mu)).max(plain);
-            }
-        }
-        t += step;
-        if t >= 1.0 {
-            return None;
-        }
+        d.is_finite().then_some((d, qa, qb))
     }
-    None
+
+    fn nearest_drift(&mut self, drift: &Drift) -> f64 {
+        self.nearest.map_or(0.0, |k| {
+            let c = &self.candidates[k];
+            drift.step(&self.tris_a[c.x as usize], &self.tris_b[c.y as usize])
+        })
+    }
+
+    fn extend(&mut self, drift: &Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64 {
+        let mut step = first;
+        for c in self.candidates.iter() {
+            if step <= plain {
+                break;
+            }
+            // Pairs whose own distance bound already allows the step need no more.
+            let bound = c.d as f64 - mu * (self.t - c.t) - LIPSCHITZ_SLACK_MM;
+            if bound - h >= mu * step {
+                continue;
+            }
+            let own = drift.step(&self.tris_a[c.x as usize], &self.tris_b[c.y as usize]);
+            step = step.min(own.max((bound - h) / mu)).max(plain);
+        }
+        step
+    }
 }

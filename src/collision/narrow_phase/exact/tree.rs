@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
-use super::drift::{Drift, Relative};
-use super::{Frame, MAX_STEPS, PlacedTri, Settle, Settled, relative};
+use super::drift::Drift;
+use super::{Candidates, Frame, PlacedTri, Settle, advance_over, relative};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::lanes::Affine32;
 use crate::collision::narrow_phase::{Body, PairContact, continuous};
@@ -13,6 +13,7 @@ use crate::geometry::{Aabb, NO_PARENT, Slab, TriangleBvh, closest_points_facing_
 
 /// Per-thread scratch of the advancement, indexed by mesh triangle or hierarchy node and stamped
 /// per query (or per step), so nothing is cleared between queries.
+#[derive(Default)]
 struct Scratch {
     /// Sphere-tree leaves whose triangles are already listed.
     leaf_a: NodeCache<u32>,
@@ -42,26 +43,7 @@ struct Scratch {
 }
 
 thread_local! {
-    static SCRATCH: std::cell::RefCell<Scratch> = const {
-        std::cell::RefCell::new(Scratch {
-            leaf_a: NodeCache::new(),
-            leaf_b: NodeCache::new(),
-            cand_a: NodeCache::new(),
-            cand_b: NodeCache::new(),
-            links_a: Vec::new(),
-            links_b: Vec::new(),
-            meets: Vec::new(),
-            leaves_b: 0,
-            node_a: NodeCache::new(),
-            node_b: NodeCache::new(),
-            placed_a: NodeCache::new(),
-            placed_b: NodeCache::new(),
-            box_b: NodeCache::new(),
-            proj_a: NodeCache::new(),
-            proj_b: NodeCache::new(),
-            stack: Vec::new(),
-        })
-    };
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 /// Conservative advancement over the bodies' whole motion through the triangle hierarchies.
@@ -99,6 +81,33 @@ struct Search<'s, 'm> {
     /// The search axis (first tooth's frame): near the contact both surfaces lie across it, so
     /// their nodes' projections on it are thin and bound the node pairs tightly.
     axis: Vec3,
+    /// The nearest pair of the last search, measured first in the next.
+    last: Option<(u32, u32)>,
+}
+
+impl Candidates for Search<'_, '_> {
+    fn place(&mut self, _t: f64, frame: &Frame) {
+        self.s.placed_b.begin(self.mb.triangles.len());
+        self.s.box_b.begin(self.bb.nodes.len());
+        self.rel = frame.rel;
+    }
+
+    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, Vec3, Vec3)> {
+        let (d, qa, qb, pair) = self.nearest(self.last, axis, enough);
+        self.last = Some(pair);
+        d.is_finite().then_some((d, qa, qb))
+    }
+
+    fn nearest_drift(&mut self, drift: &Drift) -> f64 {
+        self.last.map_or(0.0, |(x, y)| {
+            let (tx, ty) = (self.tri_a(x), self.tri_b(y));
+            drift.step(&tx, &ty)
+        })
+    }
+
+    fn extend(&mut self, drift: &Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64 {
+        self.step(drift, mu, h, plain, first)
+    }
 }
 
 impl Search<'_, '_> {
@@ -450,7 +459,7 @@ fn advance_with(
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
     let (ma, mb) = (&ga.mesh, &gb.mesh);
     let (ba, bb) = (&ga.bvh, &gb.bvh);
-    let mut t = swept
+    let t = swept
         .leaf_times
         .iter()
         .map(|x| x.2)
@@ -546,11 +555,8 @@ fn advance_with(
         motion.speed_bound_of(ids.iter().flat_map(|&t| mesh.triangle(t as usize)))
     };
     let mu = (speed(&a.motion, ma, &ids_a) + speed(&b.motion, mb, &ids_b)) * (1.0 + 1e-6);
-    let motions = Relative::new(&a.motion, &b.motion, b.shape.max_rho as f64);
-    // The first search starts along the direction between the nearest leaf pair's centres; later
-    // ones from the previous step's nearest pair and the direction between its closest points.
     let start_rel = relative(&a.motion, &b.motion, t).rel;
-    let mut axis = swept
+    let axis = swept
         .leaf_times
         .iter()
         .map(|&(i, j, _)| {
@@ -560,7 +566,6 @@ fn advance_with(
         })
         .min_by(|x, y| x.0.total_cmp(&y.0))
         .map_or(Vec3::X, |(_, v)| v.normalize_or(Vec3::X));
-    let mut nearest: Option<(u32, u32)> = None;
     let ctx = Settle {
         a,
         b,
@@ -568,61 +573,15 @@ fn advance_with(
         tol,
         mu,
     };
-    for round in 0..=MAX_STEPS {
-        // Work in a's frame: a's triangles as stored, b's mapped by pose_a⁻¹ ∘ pose_b.
-        let Frame {
-            pose_a,
-            pose_b,
-            to_a,
-            rel,
-        } = relative(&a.motion, &b.motion, t);
-        scratch.placed_b.begin(mb.triangles.len());
-        scratch.box_b.begin(bb.nodes.len());
-        let mut search = Search {
-            ma,
-            mb,
-            ba,
-            bb,
-            s: &mut *scratch,
-            rel,
-            axis: Vec3::X,
-        };
-        // After the start of the motion the teeth cannot interpenetrate (no leaf pair met
-        // before the earliest leaf time, and each step keeps half the tolerance), so any pair
-        // within the tolerance is a contact to report and the search stops at the first one
-        // found. At the start they may already interpenetrate, which only the least distance
-        // (0) shows.
-        let enough = if t > 0.0 { tol as f32 } else { -1.0 };
-        let (d, qa, qb, pair) = search.nearest(nearest, axis, enough);
-        if !d.is_finite() {
-            return None;
-        }
-        nearest = Some(pair);
-        axis = (qb - qa).normalize_or(axis);
-        let frame = Frame {
-            pose_a,
-            pose_b,
-            to_a,
-            rel,
-        };
-        let last = round == MAX_STEPS;
-        let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, [&ids_a, &ids_b], last) {
-            Settled::Report(c) => return Some(c),
-            Settled::Stuck => return None,
-            Settled::Step { h, plain } => (h, plain),
-        };
-        let mut step = plain;
-        if let Some(drift) = motions.drift(t, to_a, axis, &rel, h) {
-            let (tx, ty) = (search.tri_a(pair.0), search.tri_b(pair.1));
-            let first = drift.step(&tx, &ty).min(1.0 - t).max(plain);
-            if first > plain {
-                step = search.step(&drift, mu, h, plain, first);
-            }
-        }
-        t += step;
-        if t >= 1.0 {
-            return None;
-        }
-    }
-    None
+    let mut search = Search {
+        ma,
+        mb,
+        ba,
+        bb,
+        s: scratch,
+        rel: start_rel,
+        axis: Vec3::X,
+        last: None,
+    };
+    advance_over(&ctx, t, axis, [&ids_a, &ids_b], &mut search)
 }
