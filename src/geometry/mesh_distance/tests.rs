@@ -6,13 +6,18 @@ pub(super) fn refs(m: &TriMesh) -> (TriMesh, TriangleBvh) {
     (m.clone(), TriangleBvh::build(m))
 }
 
+/// The query view of a mesh and its hierarchy.
+fn view(m: &(TriMesh, TriangleBvh)) -> MeshRef<'_> {
+    MeshRef {
+        mesh: &m.0,
+        bvh: &m.1,
+    }
+}
+
 #[test]
 fn separated_boxes_have_their_gap() {
-    let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-    let r = MeshRef {
-        mesh: &m,
-        bvh: &bvh,
-    };
+    let unit = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+    let r = view(&unit);
     let s = mesh_separation(
         r,
         &Pose::IDENTITY,
@@ -26,11 +31,8 @@ fn separated_boxes_have_their_gap() {
 
 #[test]
 fn overlapping_boxes_report_penetration() {
-    let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-    let r = MeshRef {
-        mesh: &m,
-        bvh: &bvh,
-    };
+    let unit = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+    let r = view(&unit);
     let s = mesh_separation(
         r,
         &Pose::IDENTITY,
@@ -44,18 +46,12 @@ fn overlapping_boxes_report_penetration() {
 
 #[test]
 fn a_box_inside_another_is_overlapping() {
-    let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
-    let (small, small_bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+    let big = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
+    let small = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
     let s = mesh_separation(
-        MeshRef {
-            mesh: &big,
-            bvh: &big_bvh,
-        },
+        view(&big),
         &Pose::IDENTITY,
-        MeshRef {
-            mesh: &small,
-            bvh: &small_bvh,
-        },
+        view(&small),
         &Pose::new(Quat::from_rotation_y(0.3), Vec3::ZERO),
     );
     assert!(s.overlapping());
@@ -64,11 +60,8 @@ fn a_box_inside_another_is_overlapping() {
 
 #[test]
 fn a_bounded_separation_agrees_within_its_limit_and_is_none_beyond() {
-    let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-    let r = MeshRef {
-        mesh: &m,
-        bvh: &bvh,
-    };
+    let unit = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+    let r = view(&unit);
     let rotated = |x: f32| Pose::new(Quat::from_rotation_z(0.2), Vec3::new(x, 0.4, 0.1));
     for x in [0.7, 1.0, 1.3, 1.6, 2.4] {
         let full = mesh_separation(r, &Pose::IDENTITY, r, &rotated(x));
@@ -86,28 +79,16 @@ fn a_bounded_separation_agrees_within_its_limit_and_is_none_beyond() {
         }
     }
     // A solid inside another has no surface within any limit but is still reported.
-    let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
-    let s = mesh_separation_within(
-        MeshRef {
-            mesh: &big,
-            bvh: &big_bvh,
-        },
-        &Pose::IDENTITY,
-        r,
-        &Pose::IDENTITY,
-        0.01,
-    )
-    .expect("containment is within every limit");
+    let big = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
+    let s = mesh_separation_within(view(&big), &Pose::IDENTITY, r, &Pose::IDENTITY, 0.01)
+        .expect("containment is within every limit");
     assert!(s.overlapping() && s.penetration > 3.5, "{s:?}");
 }
 
 #[test]
 fn inside_test_on_a_rotated_box() {
-    let (m, bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-    let r = MeshRef {
-        mesh: &m,
-        bvh: &bvh,
-    };
+    let unit = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
+    let r = view(&unit);
     assert!(point_inside_mesh(r, Vec3::splat(0.5)));
     assert!(point_inside_mesh(r, Vec3::new(0.5, 0.5, 0.999)));
     assert!(!point_inside_mesh(r, Vec3::new(0.5, 0.5, 1.001)));
