@@ -283,6 +283,34 @@ pub fn run(
     }
 }
 
+/// The exact gap of each pair at the start (or, with `end`, the end) of its step.
+fn pose_gaps(
+    teeth: &[BenchTooth],
+    pairs: &[(usize, usize, Motion, Motion)],
+    end: bool,
+) -> Vec<f32> {
+    pairs
+        .iter()
+        .map(|&(i, j, ma, mb)| {
+            let (pa, pb) = if end {
+                (ma.end, mb.end)
+            } else {
+                (ma.start, mb.start)
+            };
+            exact_gap(&teeth[i], &pa, &teeth[j], &pb)
+        })
+        .collect()
+}
+
+/// Mean of `x`, 0 when empty.
+fn mean(x: &[f64]) -> f64 {
+    if x.is_empty() {
+        0.0
+    } else {
+        x.iter().sum::<f64>() / x.len() as f64
+    }
+}
+
 /// Every method on one set; `done(k)` after the reference and after each method.
 fn measure(
     teeth: &[BenchTooth],
@@ -294,14 +322,10 @@ fn measure(
         .iter()
         .map(|&(i, j, ma, mb)| query(Method::Exact, &body(&teeth[i], ma), &body(&teeth[j], mb)))
         .collect();
-    let end_gap: Vec<f32> = pairs
-        .iter()
-        .map(|&(i, j, ma, mb)| exact_gap(&teeth[i], &ma.end, &teeth[j], &mb.end))
-        .collect();
-    let start_gap: Vec<f32> = pairs
-        .iter()
-        .map(|&(i, j, ma, mb)| exact_gap(&teeth[i], &ma.start, &teeth[j], &mb.start))
-        .collect();
+    let (start_gap, end_gap) = (
+        pose_gaps(teeth, pairs, false),
+        pose_gaps(teeth, pairs, true),
+    );
     done(1);
     let mut methods = Vec::new();
     for (k, method) in Method::ALL.into_iter().enumerate() {
@@ -351,11 +375,7 @@ fn measure(
             us_per_pair,
             false_negatives: fneg,
             false_positives: fpos,
-            mean_error_mm: if errors.is_empty() {
-                0.0
-            } else {
-                errors.iter().sum::<f64>() / errors.len() as f64
-            },
+            mean_error_mm: mean(&errors),
             max_error_mm: errors.iter().copied().fold(0.0, f64::max),
         });
         done(k + 2);
@@ -408,20 +428,10 @@ pub fn sweep(
     passes: usize,
     done: &dyn Fn(usize),
 ) -> Vec<ParetoPoint> {
-    let gaps = |end: bool| -> Vec<f32> {
-        pairs
-            .iter()
-            .map(|&(i, j, ma, mb)| {
-                let (pa, pb) = if end {
-                    (ma.end, mb.end)
-                } else {
-                    (ma.start, mb.start)
-                };
-                exact_gap(&teeth[i], &pa, &teeth[j], &pb)
-            })
-            .collect()
-    };
-    let (start_gap, end_gap) = (gaps(false), gaps(true));
+    let (start_gap, end_gap) = (
+        pose_gaps(teeth, pairs, false),
+        pose_gaps(teeth, pairs, true),
+    );
     let run_all = |tolerance: f64, out: &mut Vec<Option<PairContact>>| {
         out.clear();
         out.extend(pairs.iter().map(|&(i, j, ma, mb)| {
@@ -472,11 +482,7 @@ pub fn sweep(
                 range_us: [t[0], t[t.len() - 1]],
                 contacts: found.iter().filter(|r| r.is_some()).count(),
                 max_error_mm: errors.iter().copied().fold(0.0, f64::max),
-                mean_error_mm: if errors.is_empty() {
-                    0.0
-                } else {
-                    errors.iter().sum::<f64>() / errors.len() as f64
-                },
+                mean_error_mm: mean(&errors),
                 false_negatives,
             }
         })

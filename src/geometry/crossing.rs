@@ -27,10 +27,9 @@ pub fn crossing_triangles(
     }
     // Work in a's frame.
     let in_a = InFirst::new(pose_a, b, pose_b);
-    let bbox = |node: u32| in_a.node_box(node);
     let within = within.max(0.0);
     let reach = within * within;
-    let mut stack: Vec<(u32, u32, Aabb)> = vec![(0, 0, bbox(0))];
+    let mut stack: Vec<(u32, u32, Aabb)> = vec![(0, 0, in_a.node_box(0))];
     while let Some((na, nb, box_b)) = stack.pop() {
         let (node_a, node_b) = (a.bvh.nodes[na as usize], b.bvh.nodes[nb as usize]);
         if node_a.aabb.distance_squared(&box_b) > reach {
@@ -60,7 +59,7 @@ pub fn crossing_triangles(
             stack.extend([l, l + 1].map(|c| (c, nb, box_b)));
         } else {
             let l = node_b.start;
-            stack.extend([l, l + 1].map(|c| (na, c, bbox(c))));
+            stack.extend([l, l + 1].map(|c| (na, c, in_a.node_box(c))));
         }
     }
     for list in [&mut near_a, &mut near_b] {

@@ -114,14 +114,13 @@ pub fn closest_triangles(
     }
     // Work in a's frame.
     let in_a = InFirst::new(pose_a, b, pose_b);
-    let bbox = |node: u32| in_a.node_box(node);
     let mut best: Option<(TrianglePair, usize, usize)> = None;
     let mut best_d2 = if max_distance.is_finite() {
         max_distance * max_distance
     } else {
         f32::INFINITY
     };
-    let mut stack: Vec<(f32, u32, u32, Aabb)> = vec![(0.0, 0, 0, bbox(0))];
+    let mut stack: Vec<(f32, u32, u32, Aabb)> = vec![(0.0, 0, 0, in_a.node_box(0))];
     while let Some((d2, na, nb, box_b)) = stack.pop() {
         if d2 > best_d2 {
             continue;
@@ -163,7 +162,7 @@ pub fn closest_triangles(
         } else {
             let l = node_b.start;
             [l, l + 1].map(|c| {
-                let cb = bbox(c);
+                let cb = in_a.node_box(c);
                 (node_a.aabb.distance_squared(&cb), na, c, cb)
             })
         };
