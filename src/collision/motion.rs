@@ -145,32 +145,30 @@ fn dquat(q: Quat) -> DQuat {
 }
 
 /// Per-thread scratch for per-node values computed once per query: a value is valid when its stamp
-/// equals the current query's stamp, so nothing is cleared or allocated between queries.
+/// equals the current query's stamp, so nothing is cleared or allocated between queries. Each
+/// value sits beside its stamp, so a look-up touches one place in memory.
 #[derive(Default)]
 pub(crate) struct NodeCache<T: Copy + Default> {
-    values: Vec<T>,
-    stamps: Vec<u32>,
+    slots: Vec<(u32, T)>,
     now: u32,
 }
 
 impl<T: Copy + Default> NodeCache<T> {
     pub(crate) const fn new() -> Self {
         Self {
-            values: Vec::new(),
-            stamps: Vec::new(),
+            slots: Vec::new(),
             now: 0,
         }
     }
 
     /// Starts a query over `n` nodes.
     pub(crate) fn begin(&mut self, n: usize) {
-        if self.values.len() < n {
-            self.values.resize(n, T::default());
-            self.stamps.resize(n, 0);
+        if self.slots.len() < n {
+            self.slots.resize(n, (0, T::default()));
         }
         self.now = self.now.wrapping_add(1);
         if self.now == 0 {
-            self.stamps.iter_mut().for_each(|s| *s = 0);
+            self.slots.iter_mut().for_each(|s| s.0 = 0);
             self.now = 1;
         }
     }
@@ -178,34 +176,30 @@ impl<T: Copy + Default> NodeCache<T> {
     /// Sets the value of node `i` for this query.
     #[inline]
     pub(crate) fn set(&mut self, i: usize, v: T) {
-        self.values[i] = v;
-        self.stamps[i] = self.now;
+        self.slots[i] = (self.now, v);
     }
 
     /// True when node `i` has a value in this query.
     #[inline]
     pub(crate) fn has(&self, i: usize) -> bool {
-        self.stamps[i] == self.now
+        self.slots[i].0 == self.now
     }
 
     /// The value of node `i` by reference, computed by `f` on first use in this query.
     #[inline]
     pub(crate) fn get_ref(&mut self, i: usize, f: impl FnOnce() -> T) -> &T {
-        if self.stamps[i] != self.now {
-            self.values[i] = f();
-            self.stamps[i] = self.now;
+        let now = self.now;
+        let slot = &mut self.slots[i];
+        if slot.0 != now {
+            *slot = (now, f());
         }
-        &self.values[i]
+        &slot.1
     }
 
     /// The value of node `i`, computed by `f` on first use in this query.
     #[inline]
     pub(crate) fn get(&mut self, i: usize, f: impl FnOnce() -> T) -> T {
-        if self.stamps[i] != self.now {
-            self.values[i] = f();
-            self.stamps[i] = self.now;
-        }
-        self.values[i]
+        *self.get_ref(i, f)
     }
 }
 

@@ -38,57 +38,6 @@ pub struct TriangleBvh {
     pub parent: Vec<u32>,
     /// The leaf holding each triangle.
     pub leaf_of: Vec<u32>,
-    /// Per node, a slab holding its triangles, thin where they are nearly flat (distance
-    /// queries bound node pairs by it as well as by their boxes).
-    pub slabs: Vec<Slab>,
-}
-
-/// Every vertex p of a node's triangles has `lo ≤ normal · p ≤ hi` (computed in f64 and rounded
-/// outwards, so exact for the stored normal). The normal is the node's mean face normal (any unit
-/// vector when those cancel).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Slab {
-    /// Unit normal (f32).
-    pub normal: Vec3,
-    /// Least projection.
-    pub lo: f32,
-    /// Greatest projection.
-    pub hi: f32,
-}
-
-impl Slab {
-    /// The slab of `triangles` of `mesh` about their area-weighted mean normal.
-    fn of(mesh: &TriMesh, triangles: &[u32]) -> Self {
-        let n = triangles
-            .iter()
-            .map(|&t| {
-                let [a, b, c] = mesh.triangle(t as usize).map(|v| v.as_dvec3());
-                (b - a).cross(c - a)
-            })
-            .fold(glam::DVec3::ZERO, |s, n| s + n);
-        let normal = n.normalize_or(glam::DVec3::X).as_vec3();
-        let nd = normal.as_dvec3();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &t in triangles {
-            for v in mesh.triangle(t as usize) {
-                let x = nd.dot(v.as_dvec3());
-                lo = lo.min(x);
-                hi = hi.max(x);
-            }
-        }
-        let (mut l, mut h) = (lo as f32, hi as f32);
-        if l as f64 > lo {
-            l = l.next_down();
-        }
-        if (h as f64) < hi {
-            h = h.next_up();
-        }
-        Self {
-            normal,
-            lo: l,
-            hi: h,
-        }
-    }
 }
 
 /// [`TriangleBvh::parent`] of the root.
@@ -106,7 +55,6 @@ impl TriangleBvh {
             order: (0..mesh.triangles.len() as u32).collect(),
             parent: Vec::new(),
             leaf_of: vec![0; mesh.triangles.len()],
-            slabs: Vec::new(),
         };
         if mesh.triangles.is_empty() {
             return bvh;
@@ -129,20 +77,6 @@ impl TriangleBvh {
                 bvh.parent[node.start as usize + 1] = k as u32;
             }
         }
-        // Each node's triangles are one run of `order` (children follow their parent).
-        let mut runs = vec![(0u32, 0u32); bvh.nodes.len()];
-        for k in (0..bvh.nodes.len()).rev() {
-            let node = bvh.nodes[k];
-            runs[k] = if node.is_leaf() {
-                (node.start, node.start + node.count)
-            } else {
-                (runs[node.start as usize].0, runs[node.start as usize + 1].1)
-            };
-        }
-        bvh.slabs = runs
-            .iter()
-            .map(|&(lo, hi)| Slab::of(mesh, &bvh.order[lo as usize..hi as usize]))
-            .collect();
         bvh
     }
 
@@ -261,34 +195,27 @@ mod tests {
         TriMesh::new(v, t)
     }
 
-    /// Parents, leaves and slabs agree with the nodes: every triangle sits in its leaf, under
-    /// each of its ancestors, and every vertex below a node lies within the node's slab.
+    /// Parents and leaves agree with the nodes: every triangle sits in its leaf and under each of
+    /// its ancestors, whose boxes hold it.
     #[test]
-    fn parents_leaves_and_slabs_hold_their_triangles() {
+    fn parents_and_leaves_hold_their_triangles() {
         let mesh = sheet(12);
         let bvh = TriangleBvh::build(&mesh);
         assert!(bvh.nodes.len() > 7);
         assert_eq!(bvh.parent[0], NO_PARENT);
-        let mut thin = 0;
         for t in 0..mesh.triangles.len() as u32 {
             let mut n = bvh.leaf_of[t as usize];
             assert!(bvh.leaf_triangles(&bvh.nodes[n as usize]).contains(&t));
             let mut levels = 0;
             while n != NO_PARENT {
-                let s = bvh.slabs[n as usize];
-                assert!((s.normal.length() - 1.0).abs() < 1e-5);
+                let b = bvh.nodes[n as usize].aabb;
                 for v in mesh.triangle(t as usize) {
-                    let x = s.normal.as_dvec3().dot(v.as_dvec3());
-                    assert!(s.lo as f64 <= x && x <= s.hi as f64, "{x} outside {s:?}");
+                    assert!(b.distance_squared_to_point(v) == 0.0, "{v} outside {b:?}");
                 }
                 n = bvh.parent[n as usize];
                 levels += 1;
             }
             assert!(levels >= 2);
-            let leaf = bvh.slabs[bvh.leaf_of[t as usize] as usize];
-            thin += (leaf.hi - leaf.lo < 1e-4) as usize;
         }
-        // The sheet is flat, though tilted: the slabs have no thickness to speak of.
-        assert_eq!(thin, mesh.triangles.len());
     }
 }

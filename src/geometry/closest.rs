@@ -99,11 +99,23 @@ pub struct TrianglePair {
 /// rounding; the axes are the two face normals, the nine edge–edge cross products and, for
 /// (nearly) coplanar triangles, the in-plane edge normals.
 pub fn triangles_intersect(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> bool {
+    triangles_within(t1, t2, 0.0)
+}
+
+/// [`triangles_intersect`] widened by `margin` (mm): false only when one of the same axes
+/// separates the triangles by more than the margin, so every pair within the margin of each other
+/// (and some pairs farther apart) gives true.
+pub fn triangles_within(t1: &[Vec3; 3], t2: &[Vec3; 3], margin: f32) -> bool {
     let separated = |axis: Vec3| -> bool {
         let len2 = axis.length_squared();
         if len2 <= f32::MIN_POSITIVE {
             return false;
         }
+        let pad = if margin > 0.0 {
+            margin * len2.sqrt()
+        } else {
+            0.0
+        };
         let (mut min1, mut max1) = (f32::INFINITY, f32::NEG_INFINITY);
         let (mut min2, mut max2) = (f32::INFINITY, f32::NEG_INFINITY);
         for k in 0..3 {
@@ -114,7 +126,7 @@ pub fn triangles_intersect(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> bool {
             min2 = min2.min(b);
             max2 = max2.max(b);
         }
-        max1 < min2 || max2 < min1
+        max1 + pad < min2 || max2 + pad < min1
     };
     let e1 = [t1[1] - t1[0], t1[2] - t1[1], t1[0] - t1[2]];
     let e2 = [t2[1] - t2[0], t2[2] - t2[1], t2[0] - t2[2]];
@@ -514,6 +526,15 @@ mod tests {
         assert!(!triangles_intersect(&t1, &t2));
         let r = closest_points_triangle_triangle(&t1, &t2);
         assert!((r.distance - 0.3).abs() < 1e-6, "{r:?}");
+        // Within a margin above the gap they count as near, within one below it they do not.
+        assert!(triangles_within(&t1, &t2, 0.31));
+        assert!(!triangles_within(&t1, &t2, 0.29));
+        // Corner to corner: near within the distance; the axes separate them by at least the
+        // planes' 0.5 (and may by less than the distance: the test is a superset).
+        let t3 = tri([3.0, -1.0, 0.5], [3.0, 1.0, 0.5], [4.0, 0.0, 0.5]);
+        let d = closest_points_triangle_triangle(&t1, &t3).distance;
+        assert!(triangles_within(&t1, &t3, d * 1.01));
+        assert!(!triangles_within(&t1, &t3, 0.49), "{d}");
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //!   overlapping; its `penetration` is the largest distance from a vertex or triangle centroid of
 //!   one mesh lying inside the other to that other's surface: a lower bound of the true penetration
 //!   depth that is exact when the deepest point is a vertex (the usual case for convex tips).
-//! - [`mesh_penetration_near`] gives the same estimate from the triangles at the contact, walking
+//! - [`super::mesh_penetration_near`] gives the same estimate from the triangles at the contact, walking
 //!   only the part of each surface that lies inside the other (see its doc for why that finds
 //!   every sample point the whole-mesh search would).
 
@@ -21,7 +21,6 @@ use super::{
         TrianglePair, closest_point_triangle, closest_points_triangle_triangle, triangle_plane_gap,
     },
     pose::Pose,
-    stars::VertexStars,
     trimesh::TriMesh,
 };
 
@@ -355,100 +354,8 @@ pub fn mesh_penetration(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) ->
     if da >= db { (da, pa, qa) } else { (db, qb, pb) }
 }
 
-/// One side of [`mesh_penetration_near`]: a mesh, its vertex stars, and triangles of it that
-/// include every triangle meeting the other mesh's surface.
-#[derive(Clone, Copy)]
-pub struct NearContact<'a> {
-    /// The mesh with its hierarchy.
-    pub mesh: MeshRef<'a>,
-    /// Its vertex stars ([`VertexStars::of`] the same mesh).
-    pub stars: &'a VertexStars,
-    /// Triangle indices: every triangle that meets the other surface must be among them (more
-    /// are allowed).
-    pub near: &'a [u32],
-}
-
-/// [`mesh_penetration`] found from the contact: the same estimate (the deepest vertex or triangle
-/// centroid of either mesh inside the other), sampling only the part of each surface that lies
-/// inside the other.
-///
-/// Why that finds every sample point inside the other mesh: a vertex inside with a neighbour
-/// outside ends an edge that crosses the other surface, so the triangles on that edge meet the
-/// other surface and are among `near`; the vertices inside connect to such a vertex through
-/// vertices inside, unless their whole piece of the mesh is inside (each piece's first vertex is
-/// therefore tested too). A triangle with its centroid inside has a corner inside, reached by the
-/// walk, or crosses the other surface and is among `near`. The walk starts at the corners and
-/// centroids of `near` and spreads from each vertex found inside to the triangles around it.
-pub fn mesh_penetration_near(
-    a: NearContact,
-    pose_a: &Pose,
-    b: NearContact,
-    pose_b: &Pose,
-) -> (f32, Vec3, Vec3) {
-    let (da, pa, qa) = Walk::new(&a, pose_a, b.mesh, pose_b).deepest();
-    let (db, pb, qb) = Walk::new(&b, pose_b, a.mesh, pose_a).deepest();
-    if da >= db { (da, pa, qa) } else { (db, qb, pb) }
-}
-
-/// The walk of [`mesh_penetration_near`] over one mesh's part inside the other.
-struct Walk<'a> {
-    a: NearContact<'a>,
-    seen_vertex: Vec<bool>,
-    seen_triangle: Vec<bool>,
-    inside: Vec<u32>,
-    deepest: Deepest<'a>,
-}
-
-impl<'a> Walk<'a> {
-    fn new(a: &NearContact<'a>, pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
-        Self {
-            a: *a,
-            seen_vertex: vec![false; a.mesh.mesh.vertices.len()],
-            seen_triangle: vec![false; a.mesh.mesh.triangles.len()],
-            inside: Vec::new(),
-            deepest: Deepest::new(pose_a, b, pose_b),
-        }
-    }
-
-    /// Depth, point (world) and nearest point of b's surface (world), as [`deepest_point`].
-    fn deepest(mut self) -> (f32, Vec3, Vec3) {
-        for &t in self.a.near {
-            self.triangle(t);
-        }
-        for &v in self.a.stars.pieces() {
-            self.vertex(v);
-        }
-        while let Some(v) = self.inside.pop() {
-            for &t in self.a.stars.around(v as usize) {
-                self.triangle(t);
-            }
-        }
-        self.deepest.result()
-    }
-
-    fn triangle(&mut self, t: u32) {
-        if std::mem::replace(&mut self.seen_triangle[t as usize], true) {
-            return;
-        }
-        let [p, q, r] = self.a.mesh.mesh.triangle(t as usize);
-        self.deepest.sample((p + q + r) / 3.0);
-        for v in self.a.mesh.mesh.triangles[t as usize] {
-            self.vertex(v);
-        }
-    }
-
-    fn vertex(&mut self, v: u32) {
-        if std::mem::replace(&mut self.seen_vertex[v as usize], true) {
-            return;
-        }
-        if self.deepest.sample(self.a.mesh.mesh.vertices[v as usize]) {
-            self.inside.push(v);
-        }
-    }
-}
-
 /// The deepest of the sample points of one mesh (its local frame) that lie inside another, b.
-struct Deepest<'a> {
+pub(super) struct Deepest<'a> {
     b: MeshRef<'a>,
     a_in_b: Pose,
     pose_b: Pose,
@@ -458,7 +365,7 @@ struct Deepest<'a> {
 }
 
 impl<'a> Deepest<'a> {
-    fn new(pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
+    pub(super) fn new(pose_a: &Pose, b: MeshRef<'a>, pose_b: &Pose) -> Self {
         let to_b = pose_b.inverse();
         let origin = to_b.transform_point(pose_a.translation);
         Self {
@@ -470,29 +377,55 @@ impl<'a> Deepest<'a> {
         }
     }
 
-    /// Whether the point (the first mesh's frame) lies inside b; the deepest so far is kept.
-    fn sample(&mut self, local: Vec3) -> bool {
-        let p = self.a_in_b.transform_point(local);
+    /// A point of the first mesh (its frame) in b's frame.
+    #[inline]
+    pub(super) fn place(&self, local: Vec3) -> Vec3 {
+        self.a_in_b.transform_point(local)
+    }
+
+    /// Whether `p` (b's frame) lies inside b.
+    pub(super) fn inside(&self, p: Vec3) -> bool {
         if self.b_box.distance_squared_to_point(p) > 0.0 {
             return false;
         }
         // Samples inside lie near b's surface: a ray away from b's middle leaves it at once.
         let out = (p - self.b_box.centre()).normalize_or_zero();
         let first = (out.abs().min_element() > 1e-3).then_some(out);
-        if !point_inside_mesh_along(self.b, p, first) {
-            return false;
+        point_inside_mesh_along(self.b, p, first)
+    }
+
+    /// The depth of `p` (b's frame, inside b), known to be at most `bound`: measured only when
+    /// it could exceed the deepest so far (the deepest is kept), else `bound` is returned. The
+    /// deepest found is the same as measuring every sample.
+    pub(super) fn depth(&mut self, p: Vec3, bound: f32) -> f32 {
+        if bound <= self.best.0 {
+            return bound;
         }
-        if let Some((q, d)) = closest_point_on_mesh(self.b, p)
-            && d > self.best.0
-        {
+        let limit = bound * (1.0 + 1e-5) + 1e-5;
+        let Some((q, d)) = closest_point_on_mesh_within(self.b, p, limit)
+            .or_else(|| closest_point_on_mesh(self.b, p))
+        else {
+            return bound;
+        };
+        if d > self.best.0 {
             self.best = (d, p, q);
         }
-        true
+        d
+    }
+
+    /// Whether the point (the first mesh's frame) lies inside b; the deepest so far is kept.
+    fn sample(&mut self, local: Vec3) -> bool {
+        let p = self.place(local);
+        let inside = self.inside(p);
+        if inside {
+            self.depth(p, f32::INFINITY);
+        }
+        inside
     }
 
     /// Depth, point (world) and nearest point of b's surface (world); depth 0 and the first
     /// mesh's origin when no sample lay inside.
-    fn result(self) -> (f32, Vec3, Vec3) {
+    pub(super) fn result(self) -> (f32, Vec3, Vec3) {
         let (d, p, q) = self.best;
         (
             d,
@@ -517,141 +450,4 @@ fn deepest_point(a: MeshRef, pose_a: &Pose, b: MeshRef, pose_b: &Pose) -> (f32, 
 }
 
 #[cfg(test)]
-mod tests;
-
-/// The penetration walk checked on real teeth (kept here, with the test-only use of the teeth
-/// above this layer, so that the layer check's test-block rule covers it).
-#[cfg(test)]
-mod tooth_tests {
-    use super::tests::refs;
-    use super::*;
-    use crate::geometry::trimesh::tests::cuboid;
-    use glam::Quat;
-
-    /// Triangles of `a` (posed) that meet `b`'s surface, by testing every pair.
-    fn meeting(a: &TriMesh, pose_a: &Pose, b: &TriMesh, pose_b: &Pose) -> Vec<u32> {
-        let world =
-            |m: &TriMesh, pose: &Pose, i: usize| m.triangle(i).map(|v| pose.transform_point(v));
-        let boxes = |m: &TriMesh, pose: &Pose| -> Vec<Aabb> {
-            (0..m.triangles.len())
-                .map(|i| Aabb::from_points(world(m, pose, i)))
-                .collect()
-        };
-        let (boxes_a, boxes_b) = (boxes(a, pose_a), boxes(b, pose_b));
-        (0..a.triangles.len() as u32)
-            .filter(|&i| {
-                let ta = world(a, pose_a, i as usize);
-                (0..b.triangles.len()).any(|j| {
-                    boxes_a[i as usize].distance_squared(&boxes_b[j]) <= 0.0
-                        && crate::geometry::triangles_intersect(&ta, &world(b, pose_b, j))
-                })
-            })
-            .collect()
-    }
-
-    /// The walk from the contact finds the same deepest sample as the whole-mesh search, for two
-    /// real teeth overlapping by up to most of their size, and for a box wholly inside another
-    /// (no triangle meets the other surface there: the walk starts from each piece's vertex).
-    #[test]
-    fn penetration_from_the_contact_matches_the_whole_mesh_search() {
-        use crate::teeth::{Arch, ToothGeometry, ToothKind, ToothResolution};
-        let a =
-            ToothGeometry::procedural(Arch::Lower, ToothKind::FirstMolar, ToothResolution::PAPER);
-        let b = ToothGeometry::procedural(
-            Arch::Upper,
-            ToothKind::SecondPremolar,
-            ToothResolution::PAPER,
-        );
-        let mut n = crate::geometry::test_numbers(41);
-        let mut deep = 0;
-        for case in 0..60 {
-            let pose_a = Pose::new(
-                Quat::from_euler(glam::EulerRot::XYZ, n() * 6.0, n() * 6.0, n() * 6.0),
-                Vec3::new(n(), n(), n()) * 20.0,
-            );
-            let offset = Vec3::new(n(), n() + 0.5, n()) * 2.0 * (2.0 + 8.0 * (case as f32 / 60.0));
-            let pose_b = Pose::new(
-                Quat::from_euler(glam::EulerRot::XYZ, n() * 6.0, n() * 6.0, n() * 6.0),
-                pose_a.transform_point(offset),
-            );
-            let (near_a, near_b) = (
-                meeting(&a.mesh, &pose_a, &b.mesh, &pose_b),
-                meeting(&b.mesh, &pose_b, &a.mesh, &pose_a),
-            );
-            let whole = mesh_penetration(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b);
-            let walked = mesh_penetration_near(
-                NearContact {
-                    mesh: a.mesh_ref(),
-                    stars: &a.stars,
-                    near: &near_a,
-                },
-                &pose_a,
-                NearContact {
-                    mesh: b.mesh_ref(),
-                    stars: &b.stars,
-                    near: &near_b,
-                },
-                &pose_b,
-            );
-            assert_eq!(walked.0, whole.0, "case {case}");
-            if whole.0 > 0.0 {
-                assert_eq!((walked.1, walked.2), (whole.1, whole.2), "case {case}");
-            }
-            // The hierarchy search lists every meeting triangle (and only near ones).
-            let (cross_a, cross_b) = crate::geometry::crossing_triangles(
-                a.mesh_ref(),
-                &pose_a,
-                b.mesh_ref(),
-                &pose_b,
-                1e-4,
-            );
-            assert!(near_a.iter().all(|t| cross_a.contains(t)), "case {case}");
-            assert!(near_b.iter().all(|t| cross_b.contains(t)), "case {case}");
-            for &t in cross_a.iter().take(12) {
-                let ta = a
-                    .mesh
-                    .triangle(t as usize)
-                    .map(|v| pose_a.transform_point(v));
-                let nearest = (0..b.mesh.triangles.len())
-                    .map(|j| {
-                        let tb = b.mesh.triangle(j).map(|v| pose_b.transform_point(v));
-                        crate::geometry::closest_points_triangle_triangle(&ta, &tb).distance
-                    })
-                    .fold(f32::INFINITY, f32::min);
-                assert!(
-                    nearest <= 2e-4,
-                    "case {case}: triangle {t} is {nearest} mm away"
-                );
-            }
-            deep += (whole.0 > 0.5) as usize;
-        }
-        assert!(deep > 20, "{deep} deep overlaps");
-
-        let (big, big_bvh) = refs(&cuboid(Vec3::splat(-5.0), Vec3::splat(5.0)));
-        let (small, small_bvh) = refs(&cuboid(Vec3::ZERO, Vec3::ONE));
-        let (big_stars, small_stars) = (VertexStars::of(&big), VertexStars::of(&small));
-        let big_ref = MeshRef {
-            mesh: &big,
-            bvh: &big_bvh,
-        };
-        let small_ref = MeshRef {
-            mesh: &small,
-            bvh: &small_bvh,
-        };
-        let side = |mesh, stars| NearContact {
-            mesh,
-            stars,
-            near: &[],
-        };
-        let pose = Pose::new(Quat::from_rotation_y(0.3), Vec3::ZERO);
-        let walked = mesh_penetration_near(
-            side(big_ref, &big_stars),
-            &Pose::IDENTITY,
-            side(small_ref, &small_stars),
-            &pose,
-        );
-        let whole = mesh_penetration(big_ref, &Pose::IDENTITY, small_ref, &pose);
-        assert!(walked.0 > 3.5, "{walked:?}");
-        assert_eq!(walked, whole);
-    }
-}
+pub(super) mod tests;

@@ -22,28 +22,30 @@ mod section;
 pub(crate) mod sphere;
 mod stars;
 pub(crate) mod trimesh;
+mod walk;
 
 pub use aabb::Aabb;
-pub use bvh::{NO_PARENT, Slab, TriangleBvh};
+pub use bvh::{NO_PARENT, TriangleBvh};
 pub use closest::{
     FacePlane, TrianglePair, closest_point_triangle, closest_points_facing_triangles,
     closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,
-    triangle_plane_gap, triangles_intersect,
+    triangle_plane_gap, triangles_intersect, triangles_within,
 };
 pub(crate) use columns::{Columns, LocalLines};
 pub use crossing::crossing_triangles;
 pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
 pub use mat6::{Mat6, Vec6, halves, vec6};
 pub use mesh_distance::{
-    MeshRef, MeshSeparation, NearContact, closest_point_on_mesh, closest_point_on_mesh_within,
-    closest_triangles, mesh_penetration, mesh_penetration_near, mesh_separation,
-    mesh_separation_within, point_inside_mesh,
+    MeshRef, MeshSeparation, closest_point_on_mesh, closest_point_on_mesh_within,
+    closest_triangles, mesh_penetration, mesh_separation, mesh_separation_within,
+    point_inside_mesh,
 };
 pub use pose::Pose;
 pub use section::section_loops;
 pub use sphere::Sphere;
 pub use stars::VertexStars;
 pub use trimesh::{MeshError, TriMesh};
+pub use walk::{CARRY_LIMIT, NearContact, mesh_penetration_near};
 
 /// The geometry tests' seeded source of uniform numbers in [−0.5, 0.5) (a linear congruential
 /// generator: small, fixed, and the same sequence on every machine).

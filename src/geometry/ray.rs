@@ -74,6 +74,34 @@ pub(super) fn ray_parity(m: MeshRef, origin: Vec3, dir: Vec3) -> Option<bool> {
     Some(crossings % 2 == 1)
 }
 
+/// Parity of the crossings of the segment from `p` to `q` with `triangles` (each with its box),
+/// or None when it passes within 10⁻⁶ (barycentric) of one's edge, ends within 10⁻⁴ of its
+/// length from one's plane, or runs parallel to one's plane across its box: cases the parity
+/// cannot be trusted in.
+pub(super) fn segment_parity(p: Vec3, q: Vec3, triangles: &[([Vec3; 3], Aabb)]) -> Option<bool> {
+    const ENDS: f32 = 1e-4;
+    let d = q - p;
+    let span = Aabb {
+        min: p.min(q),
+        max: p.max(q),
+    };
+    let mut odd = false;
+    for (t, b) in triangles {
+        if b.distance_squared(&span) > 0.0 {
+            continue;
+        }
+        let (u, v, s) = crossing(p, d, t)?;
+        if !inside_by(u, v, -EDGE_EPS) || !(-ENDS..=1.0 + ENDS).contains(&s) {
+            continue;
+        }
+        if !inside_by(u, v, EDGE_EPS) || !(ENDS..=1.0 - ENDS).contains(&s) {
+            return None;
+        }
+        odd = !odd;
+    }
+    Some(odd)
+}
+
 /// Where the ray enters the box (0 if it starts inside), or None if it misses it.
 fn ray_box_entry(o: Vec3, inv: Vec3, b: &Aabb) -> Option<f32> {
     let t1 = (b.min - o) * inv;
@@ -121,6 +149,32 @@ fn crossing(o: Vec3, d: Vec3, t: &[Vec3; 3]) -> Option<(f32, f32, f32)> {
 mod tests {
     use super::*;
     use crate::geometry::{TriangleBvh, trimesh::tests::cuboid};
+
+    /// A segment's crossings with a box's faces: one face flips the parity, two leave it, none
+    /// leave it; a segment ending on a face, or running in a face's plane, is not trusted.
+    #[test]
+    fn segments_count_their_crossings() {
+        let m = cuboid(Vec3::ZERO, Vec3::new(4.0, 2.0, 1.0));
+        let faces: Vec<_> = (0..m.triangles.len())
+            .map(|i| {
+                let v = m.triangle(i);
+                (v, Aabb::from_points(v))
+            })
+            .collect();
+        let parity = |p: Vec3, q: Vec3| segment_parity(p, q, &faces);
+        let inside = Vec3::new(1.1, 0.7, 0.3);
+        assert_eq!(parity(inside, Vec3::new(1.3, 0.6, 1.7)), Some(true));
+        assert_eq!(
+            parity(Vec3::new(-1.0, 0.7, 0.3), Vec3::new(5.0, 0.9, 0.4)),
+            Some(false)
+        );
+        assert_eq!(parity(inside, Vec3::new(2.9, 1.2, 0.6)), Some(false));
+        assert_eq!(parity(inside, Vec3::new(1.3, 0.6, 1.0)), None);
+        assert_eq!(
+            parity(Vec3::new(0.5, 0.5, 1.0), Vec3::new(3.5, 0.5, 1.0)),
+            None
+        );
+    }
 
     /// The first hit is the nearest face along the ray, past `t_min`; a ray from a face
     /// inwards meets the opposite face; a ray away from the box meets nothing.

@@ -42,21 +42,24 @@
 //! Teeth already interpenetrating at t = 0 report time 0 and the penetration depth of the whole
 //! meshes ([`mesh_penetration_near`]: the candidate triangles hold every triangle that crosses
 //! the other surface, so the search walks from them over the part of each surface inside the
-//! other instead of testing every vertex). After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
+//! other instead of testing every vertex; the hierarchical search first narrows them to those
+//! near a candidate of the other tooth, which still holds every crossing one). After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
 //! conservative, time is reported with its gap.
 //!
 //! Two ways to search the candidates, the same pairs and the same guarantees. **Flat**
 //! (`flat.rs`, the steps above): every candidate pair listed once and looked at each step, for
 //! sets up to [`FLAT_PAIRS`] pairs (the paper's resolution). **Hierarchical** (`tree.rs`, teeth
-//! at scan resolution, where the leaf pairs hold up to millions of triangle pairs): the candidate
-//! triangles are marked in each tooth's triangle hierarchy (each node above a candidate), and
-//! each step searches the two marked hierarchies together, nearest node pairs first, starting
-//! from the previous step's nearest pair; a node pair is opened only when neither its boxes, nor
-//! its slabs (each node's triangles lie within a thin slab about their mean normal), nor its
-//! projections on the closest direction show it farther than the best so far; a triangle pair
-//! counts only if its triangles lie in a meeting leaf pair (each candidate keeps the list of its
-//! meeting leaves), as in the flat search. The directional step descends the same way, a node
-//! pair being left closed when its plain bound or its drift along the direction already allows
+//! at scan resolution, where the leaf pairs hold up to millions of triangle pairs): each tooth's
+//! candidates form a patch with a hierarchy of its own (the part of the tooth's triangle
+//! hierarchy above them, `patch.rs`), whose boxes are refitted to the candidates alone in a frame
+//! whose third axis is the search direction (the closest direction of the last step) whenever
+//! that direction or the second tooth's placement changes. Each step searches the two patches
+//! together, nearest node pairs first, starting from the previous step's nearest pair; a node
+//! pair is opened only when its boxes do not show it farther than the best so far, and a
+//! triangle pair counts only if its triangles lie in a meeting leaf pair (each candidate keeps the
+//! list of its meeting leaves), as in the flat search. The directional step descends the same
+//! way, a node pair being left closed when its plain bound or its drift along the direction (the
+//! boxes' extent along the frame's third axis) already allows
 //! the step. All node bounds are computed in f32 and lowered by far more than their rounding.
 //! Once the motion is under way (t > 0) the teeth cannot interpenetrate, so the hierarchical
 //! search stops at the first triangle pair within the tolerance and reports it: its gap is within
@@ -336,6 +339,12 @@ trait Candidates {
     /// pair allows: its own plain bound (distance less h, over μ) or its drift along the
     /// direction.
     fn extend(&mut self, drift: &drift::Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64;
+    /// After [`Self::least`] found the teeth touching: a part of each tooth's candidates (mesh
+    /// triangle numbers) that holds every candidate meeting the other's candidates, from which
+    /// the penetration depth is searched; `None` to search from all the candidates.
+    fn touching(&mut self) -> Option<[Vec<u32>; 2]> {
+        None
+    }
 }
 
 /// The advancement loop from time `t`, the first search along `axis`: search, stop or step
@@ -361,6 +370,9 @@ fn advance_over(
         let enough = if t > 0.0 { ctx.tol as f32 } else { -1.0 };
         let (d, qa, qb) = search.least(axis, enough)?;
         axis = (qb - qa).normalize_or(axis);
+        // Touching: the depth is searched from the candidates that meet.
+        let touching = if d == 0.0 { search.touching() } else { None };
+        let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
         let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(c) => return Some(c),
             Settled::Stuck => return None,
@@ -407,6 +419,7 @@ fn relative(a: &Motion, b: &Motion, t: f64) -> Frame {
 
 mod drift;
 mod flat;
+mod patch;
 mod tree;
 
 #[cfg(test)]

@@ -2,7 +2,7 @@ use super::*;
 use crate::geometry::trimesh::tests::cuboid;
 use glam::Quat;
 
-pub(super) fn refs(m: &TriMesh) -> (TriMesh, TriangleBvh) {
+pub(crate) fn refs(m: &TriMesh) -> (TriMesh, TriangleBvh) {
     (m.clone(), TriangleBvh::build(m))
 }
 

@@ -91,6 +91,7 @@ impl Relative {
 
 /// The drift of [`Relative::drift`]: speed along `n` of a point y is `c0 + y·m`, acceleration at
 /// most `accel`.
+#[derive(Clone, Copy)]
 pub(super) struct Drift {
     pub(super) n: Vec3,
     c0: f64,
@@ -111,6 +112,18 @@ impl Drift {
         let lo = |v: [f64; 3]| v[0].min(v[1]).min(v[2]);
         let hi = |v: [f64; 3]| v[0].max(v[1]).max(v[2]);
         self.spans((lo(p), hi(p)), (lo(q), hi(q)), (lo(speed), hi(speed)))
+    }
+
+    /// The same drift seen in a frame turned by `r` (rows: the frame's axes, the last being the
+    /// direction), where the direction is the third axis: for r orthonormal, y·m = (r y)·(r m).
+    /// r is rounded to f32, which moves the speeds by about 10⁻⁷ of |y|·|m|, far inside the
+    /// allowance.
+    pub(super) fn framed(&self, r: glam::Mat3) -> Drift {
+        Drift {
+            n: Vec3::Z,
+            m: r.as_dmat3() * self.m,
+            ..*self
+        }
     }
 
     /// [`Self::step`] for every pair of triangles of two nodes projecting on n within `p` and

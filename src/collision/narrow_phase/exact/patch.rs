@@ -1,0 +1,228 @@
+//! One tooth's candidate triangles as a hierarchy of their own, for the hierarchical search
+//! (`tree.rs`): the part of the tooth's triangle hierarchy above the candidates, with chains of
+//! single children collapsed, and boxes refitted to the candidates alone in the search frame.
+//!
+//! Why refit: the stored hierarchy's boxes and slabs cover every triangle of a node and lie in
+//! the mesh's axes, so near a contact, where both surfaces curve across the closest direction,
+//! they overlap far more than the triangles do. Boxes of only the candidate triangles, in a frame
+//! whose third axis is the closest direction, are as tight as axis-aligned boxes can be there:
+//! thin along the direction and exact in the other two. The candidates are a patch of a few
+//! hundred triangles, so refitting every box costs one map of the patch's vertices and one pass
+//! over its nodes.
+//!
+//! Rounding: each vertex is mapped in f32 (to within about 1.2·10⁻⁶ of its distance from the
+//! frame's origin plus the map's translation), and every box is widened by [`Patch::pad`], an
+//! absolute 10⁻⁵ mm plus a relative 4·10⁻⁶ of those sizes, so a box holds its triangles' exact
+//! images and box distances never exceed the triangles' distances.
+
+use glam::Vec3;
+
+use crate::collision::CompactTree;
+use crate::collision::motion::NodeCache;
+use crate::collision::narrow_phase::lanes::Affine32;
+use crate::geometry::{Aabb, NO_PARENT, TriMesh, TriangleBvh};
+
+/// A node of a patch: an inner node's two children, or a leaf's range of [`Patch::order`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PatchNode {
+    /// Inner: the first child; leaf: the first entry of `order`.
+    pub(super) a: u32,
+    /// Inner: the second child; leaf: the number of entries.
+    pub(super) b: u32,
+    pub(super) leaf: bool,
+}
+
+/// One tooth's candidate triangles, their hierarchy and their boxes in the search frame.
+#[derive(Default)]
+pub(super) struct Patch {
+    /// Each candidate's mesh triangle, in listing order (a candidate's number is its place here).
+    pub(super) ids: Vec<u32>,
+    /// Each candidate's vertices, as places in `vertices`.
+    corners: Vec<[u32; 3]>,
+    /// The mesh vertices of the candidates, each once.
+    vertices: Vec<u32>,
+    /// Head of each candidate's list of meeting sphere-tree leaves in `links` (leaf number, next
+    /// entry; `u32::MAX` ends a list).
+    pub(super) heads: Vec<u32>,
+    pub(super) links: Vec<(u32, u32)>,
+    /// The hierarchy, parents before children; node 0 is the root.
+    pub(super) nodes: Vec<PatchNode>,
+    /// Candidate numbers grouped by leaf.
+    pub(super) order: Vec<u32>,
+    /// Vertices, candidates and nodes in the search frame (boxes widened by the pad).
+    framed: Vec<Vec3>,
+    pub(super) tri_box: Vec<Aabb>,
+    pub(super) node_box: Vec<Aabb>,
+    /// Per mesh triangle, vertex, hierarchy node and sphere-tree leaf: its candidate number,
+    /// its place in `vertices`, whether it holds a candidate, the leaf's number.
+    cand: NodeCache<u32>,
+    vertex_of: NodeCache<u32>,
+    marked: NodeCache<bool>,
+    leaf_number: NodeCache<u32>,
+    /// Sphere-tree leaves numbered so far.
+    pub(super) leaves: u32,
+}
+
+impl Patch {
+    /// Starts a query on a mesh with `triangles` triangles, `vertices` vertices, a hierarchy of
+    /// `nodes` nodes and a sphere tree of `spheres` nodes.
+    pub(super) fn begin(&mut self, mesh: &TriMesh, bvh: &TriangleBvh, spheres: usize) {
+        self.cand.begin(mesh.triangles.len());
+        self.vertex_of.begin(mesh.vertices.len());
+        self.marked.begin(bvh.nodes.len());
+        self.leaf_number.begin(spheres);
+        self.ids.clear();
+        self.corners.clear();
+        self.vertices.clear();
+        self.heads.clear();
+        self.links.clear();
+        self.nodes.clear();
+        self.order.clear();
+        self.leaves = 0;
+    }
+
+    /// Lists the triangles of sphere-tree leaf `leaf` as candidates (each triangle once, each
+    /// remembering this leaf) and marks the hierarchy above them: the leaf's number.
+    pub(super) fn list_leaf(
+        &mut self,
+        tree: &CompactTree,
+        leaf: usize,
+        mesh: &TriMesh,
+        bvh: &TriangleBvh,
+    ) -> u32 {
+        if self.leaf_number.has(leaf) {
+            return self.leaf_number.get(leaf, || 0);
+        }
+        let number = self.leaves;
+        self.leaves += 1;
+        self.leaf_number.set(leaf, number);
+        for &x in tree.triangles(leaf) {
+            if self.cand.has(x as usize) {
+                let c = self.cand.get(x as usize, || 0) as usize;
+                self.links.push((number, self.heads[c]));
+                self.heads[c] = self.links.len() as u32 - 1;
+                continue;
+            }
+            let c = self.ids.len() as u32;
+            self.cand.set(x as usize, c);
+            self.ids.push(x);
+            self.links.push((number, u32::MAX));
+            self.heads.push(self.links.len() as u32 - 1);
+            let corners = mesh.triangles[x as usize].map(|v| {
+                let next = self.vertices.len() as u32;
+                let place = self.vertex_of.get(v as usize, || next);
+                if place == next {
+                    self.vertices.push(v);
+                }
+                place
+            });
+            self.corners.push(corners);
+            let mut n = bvh.leaf_of[x as usize];
+            while n != NO_PARENT && !self.marked.has(n as usize) {
+                self.marked.set(n as usize, true);
+                n = bvh.parent[n as usize];
+            }
+        }
+        number
+    }
+
+    /// Builds the patch's hierarchy from the marked part of `bvh` (after the listing).
+    pub(super) fn build(&mut self, bvh: &TriangleBvh) {
+        self.nodes.clear();
+        self.order.clear();
+        if self.ids.is_empty() {
+            return;
+        }
+        // (stored node, the patch node to fill); a node with one marked child is skipped.
+        let mut stack = vec![(0u32, 0u32)];
+        self.nodes.push(PatchNode {
+            a: 0,
+            b: 0,
+            leaf: true,
+        });
+        while let Some((mut n, slot)) = stack.pop() {
+            loop {
+                let node = &bvh.nodes[n as usize];
+                if node.is_leaf() {
+                    let start = self.order.len() as u32;
+                    for &x in bvh.leaf_triangles(node) {
+                        if self.cand.has(x as usize) {
+                            let c = self.cand.get(x as usize, || 0);
+                            self.order.push(c);
+                        }
+                    }
+                    self.nodes[slot as usize] = PatchNode {
+                        a: start,
+                        b: self.order.len() as u32 - start,
+                        leaf: true,
+                    };
+                    break;
+                }
+                let (l, r) = (node.start, node.start + 1);
+                match (self.marked.has(l as usize), self.marked.has(r as usize)) {
+                    (true, true) => {
+                        let first = self.nodes.len() as u32;
+                        let leaf = PatchNode {
+                            a: 0,
+                            b: 0,
+                            leaf: true,
+                        };
+                        self.nodes.extend([leaf, leaf]);
+                        self.nodes[slot as usize] = PatchNode {
+                            a: first,
+                            b: first + 1,
+                            leaf: false,
+                        };
+                        stack.push((r, first + 1));
+                        stack.push((l, first));
+                        break;
+                    }
+                    (true, false) => n = l,
+                    (false, true) => n = r,
+                    // A marked inner node always holds a marked child.
+                    (false, false) => break,
+                }
+            }
+        }
+        self.framed.resize(self.vertices.len(), Vec3::ZERO);
+        self.tri_box.resize(self.ids.len(), Aabb::EMPTY);
+        self.node_box.resize(self.nodes.len(), Aabb::EMPTY);
+    }
+
+    /// The mesh vertices of the candidates, each once.
+    pub(super) fn vertex_ids(&self) -> &[u32] {
+        &self.vertices
+    }
+
+    /// The widening of a box mapped by `map` whose framed coordinates reach `reach`.
+    fn pad(map: &Affine32, reach: f32) -> f32 {
+        1e-5 + 4e-6 * (reach + map.t.length())
+    }
+
+    /// Refits every box to the candidates mapped by `map` (mesh frame to search frame).
+    pub(super) fn refit(&mut self, mesh: &TriMesh, map: &Affine32) {
+        let mut reach = 0.0f32;
+        for (f, &v) in self.framed.iter_mut().zip(&self.vertices) {
+            *f = map.apply(mesh.vertices[v as usize]);
+            reach = reach.max(f.abs().max_element());
+        }
+        let pad = Vec3::splat(Self::pad(map, reach));
+        for (b, c) in self.tri_box.iter_mut().zip(&self.corners) {
+            let [p, q, r] = c.map(|i| self.framed[i as usize]);
+            *b = Aabb {
+                min: p.min(q).min(r) - pad,
+                max: p.max(q).max(r) + pad,
+            };
+        }
+        for i in (0..self.nodes.len()).rev() {
+            let n = self.nodes[i];
+            self.node_box[i] = if n.leaf {
+                self.order[n.a as usize..(n.a + n.b) as usize]
+                    .iter()
+                    .fold(Aabb::EMPTY, |b, &c| b.union(self.tri_box[c as usize]))
+            } else {
+                self.node_box[n.a as usize].union(self.node_box[n.b as usize])
+            };
+        }
+    }
+}
