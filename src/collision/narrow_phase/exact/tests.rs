@@ -48,6 +48,15 @@ fn directional_steps_keep_half_the_tolerance() {
         else {
             continue;
         };
+        // The same bound from the triangles' boxes in a frame along n (as the hierarchical
+        // search takes it for node pairs): as safe.
+        let r = glam::Mat3::from_cols(n.any_orthonormal_pair().0, n.any_orthonormal_pair().1, n)
+            .transpose();
+        let boxed = |v: [Vec3; 3]| crate::geometry::Aabb::from_points(v.map(|p| r * p));
+        let (bx, by) = (boxed(tx.v), boxed(ty.v));
+        let framed = drift
+            .framed(r)
+            .step_nodes((bx.min.z, bx.max.z), (by.min.z, by.max.z), &by);
         let step = drift.step(&tx, &ty).min(1.0 - t0);
         if step <= 0.0 {
             continue;
@@ -67,13 +76,15 @@ fn directional_steps_keep_half_the_tolerance() {
             let hi = |v: [f64; 3]| v[0].max(v[1]).max(v[2]);
             (lo(q) - hi(p)).max(lo(p) - hi(q))
         };
-        for k in 0..=64 {
-            let t = t0 + step * k as f64 / 64.0;
-            let gap = along(t);
-            assert!(
-                gap >= 0.5 * GAP_TOLERANCE_MM as f64 - 1e-5,
-                "case {case}: gap {gap} at {t} (step {step} from {t0})"
-            );
+        for step in [step, framed.min(1.0 - t0)] {
+            for k in 0..=64 {
+                let t = t0 + step * k as f64 / 64.0;
+                let gap = along(t);
+                assert!(
+                    gap >= 0.5 * GAP_TOLERANCE_MM as f64 - 1e-5,
+                    "case {case}: gap {gap} at {t} (step {step} from {t0})"
+                );
+            }
         }
     }
     // Most triangles placed at random are apart along the direction between them, and many
