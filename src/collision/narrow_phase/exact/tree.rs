@@ -170,19 +170,15 @@ impl Search<'_, '_> {
         self.s.pa.node_box[na as usize].distance_squared(&self.s.pb.node_box[nb as usize])
     }
 
-    /// Child node pairs of (na, nb), the larger node split.
+    /// Child node pairs of (na, nb): both nodes split when both are inner (four pairs), else
+    /// the inner one; the pairs and how many there are.
     #[inline]
-    fn children(&self, na: u32, nb: u32) -> [(u32, u32); 2] {
+    fn children(&self, na: u32, nb: u32) -> ([(u32, u32); 4], usize) {
         let (x, y) = self.nodes(na, nb);
-        let size = |b: &Aabb| b.extent().length_squared();
-        let split_a = !x.leaf
-            && (y.leaf
-                || size(&self.s.pa.node_box[na as usize])
-                    >= size(&self.s.pb.node_box[nb as usize]));
-        if split_a {
-            [(x.a, nb), (x.b, nb)]
-        } else {
-            [(na, y.a), (na, y.b)]
+        match (x.leaf, y.leaf) {
+            (false, false) => ([(x.a, y.a), (x.a, y.b), (x.b, y.a), (x.b, y.b)], 4),
+            (false, true) => ([(x.a, nb), (x.b, nb), (0, 0), (0, 0)], 2),
+            _ => ([(na, y.a), (na, y.b), (0, 0), (0, 0)], 2),
         }
     }
 
@@ -274,14 +270,14 @@ impl Search<'_, '_> {
                 }
                 continue;
             }
-            let mut kids = self
-                .children(na, nb)
-                .map(|(ca, cb)| (self.gap2(ca, cb), ca, cb));
-            // The nearer pair is searched first (pushed last).
-            if kids[0].0 < kids[1].0 {
-                kids.swap(0, 1);
+            let (pairs, n) = self.children(na, nb);
+            let mut kids = [(0.0, 0, 0); 4];
+            for (k, &(ca, cb)) in pairs[..n].iter().enumerate() {
+                kids[k] = (self.gap2(ca, cb), ca, cb);
             }
-            stack.extend(kids.into_iter().filter(|k| k.0 < best.0 * best.0));
+            // The nearest pair is searched first (pushed last).
+            kids[..n].sort_unstable_by(|p, q| q.0.total_cmp(&p.0));
+            stack.extend(kids[..n].iter().filter(|k| k.0 < best.0 * best.0));
         }
         self.s.stack = stack;
         best
@@ -337,7 +333,8 @@ impl Search<'_, '_> {
                 );
                 continue;
             }
-            stack.extend(self.children(na, nb).map(|(ca, cb)| (0.0, ca, cb)));
+            let (pairs, n) = self.children(na, nb);
+            stack.extend(pairs[..n].iter().map(|&(ca, cb)| (0.0, ca, cb)));
         }
         self.s.stack = stack;
         step.get()
@@ -371,7 +368,8 @@ impl Search<'_, '_> {
             }
             let (px, py) = self.nodes(x, y);
             if !(px.leaf && py.leaf) {
-                stack.extend(self.children(x, y).map(|(ca, cb)| (0.0, ca, cb)));
+                let (pairs, n) = self.children(x, y);
+                stack.extend(pairs[..n].iter().map(|&(ca, cb)| (0.0, ca, cb)));
                 continue;
             }
             for k in px.a..px.a + px.b {
