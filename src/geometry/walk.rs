@@ -115,7 +115,8 @@ impl<'a> Walk<'a> {
             self.triangle(t);
         }
         for &v in self.a.stars.pieces() {
-            self.alone(v);
+            let p = self.deepest.place(self.a.mesh.mesh.vertices[v as usize]);
+            self.alone(v, p);
         }
         while let Some(v) = self.inside.pop() {
             for &t in self.a.stars.around(v as usize) {
@@ -125,31 +126,26 @@ impl<'a> Walk<'a> {
         self.deepest.result()
     }
 
-    /// Vertex `v` (the first mesh's frame) in b's frame.
-    fn at(&self, v: u32) -> Vec3 {
-        self.deepest.place(self.a.mesh.mesh.vertices[v as usize])
-    }
-
     fn triangle(&mut self, t: u32) {
         if std::mem::replace(&mut self.seen_triangle[t as usize], true) {
             return;
         }
         let corners = self.a.mesh.mesh.triangles[t as usize];
+        let local = self.a.mesh.mesh.triangle(t as usize);
+        let placed = local.map(|v| self.deepest.place(v));
         // Carried from a corner whose side is known (one is tested alone when none is).
         let k = corners
             .iter()
             .position(|&c| self.side[c as usize] != Side::Unknown)
             .unwrap_or(0);
-        let base = corners[k];
-        self.alone(base);
+        let (base, start) = (corners[k], placed[k]);
+        self.alone(base, start);
         // The centroid taken in the mesh's frame, as the whole-mesh search takes it.
-        let [p, q, r] = self.a.mesh.mesh.triangle(t as usize);
-        let centroid = self.deepest.place((p + q + r) / 3.0);
-        self.sample(base, centroid);
-        for c in corners {
+        let centroid = self.deepest.place((local[0] + local[1] + local[2]) / 3.0);
+        self.sample(base, start, centroid);
+        for (c, p) in corners.into_iter().zip(placed) {
             if self.side[c as usize] == Side::Unknown {
-                let at = self.at(c);
-                self.side[c as usize] = self.sample(base, at);
+                self.side[c as usize] = self.sample(base, start, p);
                 if self.side[c as usize] != Side::Outside {
                     self.inside.push(c);
                 }
@@ -157,12 +153,12 @@ impl<'a> Walk<'a> {
         }
     }
 
-    /// Settles vertex `v` by testing it alone (rays), if its side is unknown.
-    fn alone(&mut self, v: u32) {
+    /// Settles vertex `v`, at `p` (b's frame), by testing it alone (rays), if its side is
+    /// unknown.
+    fn alone(&mut self, v: u32, p: Vec3) {
         if self.side[v as usize] != Side::Unknown {
             return;
         }
-        let p = self.at(v);
         self.side[v as usize] = if self.deepest.inside(p) {
             self.inside.push(v);
             Side::Inside(self.deepest.depth(p, f32::INFINITY))
@@ -171,10 +167,9 @@ impl<'a> Walk<'a> {
         };
     }
 
-    /// The side of the point `p` (b's frame) reached from vertex `from` (side known) along the
-    /// segment between them, measuring its depth when inside.
-    fn sample(&mut self, from: u32, p: Vec3) -> Side {
-        let start = self.at(from);
+    /// The side of the point `p` (b's frame) reached from vertex `from` (side known, at `start`)
+    /// along the segment between them, measuring its depth when inside.
+    fn sample(&mut self, from: u32, start: Vec3, p: Vec3) -> Side {
         let carried = self
             .others
             .as_ref()

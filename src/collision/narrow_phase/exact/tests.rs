@@ -50,8 +50,7 @@ fn directional_steps_keep_half_the_tolerance() {
         };
         // The same bound from the triangles' boxes in a frame along n (as the hierarchical
         // search takes it for node pairs): as safe.
-        let r = glam::Mat3::from_cols(n.any_orthonormal_pair().0, n.any_orthonormal_pair().1, n)
-            .transpose();
+        let r = super::tree::frame_of(n);
         let boxed = |v: [Vec3; 3]| crate::geometry::Aabb::from_points(v.map(|p| r * p));
         let (bx, by) = (boxed(tx.v), boxed(ty.v));
         let framed = drift

@@ -42,7 +42,7 @@ pub(super) fn advance(
 }
 
 /// The rotation taking the unit `n` to the third axis (rows: two axes across n, then n).
-fn frame_of(n: Vec3) -> Mat3 {
+pub(super) fn frame_of(n: Vec3) -> Mat3 {
     let (u, v) = n.any_orthonormal_pair();
     Mat3::from_cols(u, v, n).transpose()
 }
