@@ -6,7 +6,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 
 use crate::{
-    geometry::{Pose, Sphere},
+    geometry::{Pose, Sphere, TriMesh},
     sphere_tree::{SphereTree, TreeBuildError, TreeCache, TreeSettings},
     teeth::{Dentition, Fdi, ToothGeometry},
 };
@@ -56,6 +56,9 @@ pub struct CompactTree {
     /// Triangles each leaf touches, all leaves' lists in one array (node order): node i's list is
     /// `triangle_list[triangle_start[i]..triangle_start[i + 1]]` (see [`Self::triangles`]).
     triangle_list: Vec<u32>,
+    /// The bounding sphere of each entry of `triangle_list` (local frame), in the same order, so
+    /// that a leaf's triangles can be culled without reading the mesh.
+    triangle_spheres: Vec<Sphere>,
     /// Start of each node's list in `triangle_list`, and one past the last.
     triangle_start: Vec<u32>,
     /// Sibling groups in lanes: chunk 0 holds the root alone, then each inner node's children.
@@ -67,13 +70,14 @@ pub struct CompactTree {
 }
 
 impl CompactTree {
-    /// Copies the used slots of `tree` in breadth-first order.
-    pub fn new(tree: &SphereTree) -> Self {
+    /// Copies the used slots of `tree` (built on `mesh`) in breadth-first order.
+    pub fn new(tree: &SphereTree, mesh: &TriMesh) -> Self {
         let mut out = Self {
             spheres: Vec::new(),
             first: Vec::new(),
             count: Vec::new(),
             triangle_list: Vec::new(),
+            triangle_spheres: Vec::new(),
             triangle_start: vec![0],
             chunks: Vec::new(),
             child_chunks: Vec::new(),
@@ -103,6 +107,9 @@ impl CompactTree {
                 queue.push_back(c);
             }
         }
+        out.triangle_spheres = (out.triangle_list.iter())
+            .map(|&x| Sphere::enclosing(&mesh.triangle(x as usize)))
+            .collect();
         out.max_rho = out
             .spheres
             .iter()
@@ -152,6 +159,12 @@ impl CompactTree {
     #[inline]
     pub fn triangles(&self, i: usize) -> &[u32] {
         &self.triangle_list[self.triangle_start[i] as usize..self.triangle_start[i + 1] as usize]
+    }
+
+    /// The bounding spheres of [`Self::triangles`] of leaf `i`, in the same order.
+    #[inline]
+    pub fn triangle_spheres(&self, i: usize) -> &[Sphere] {
+        &self.triangle_spheres[self.triangle_start[i] as usize..self.triangle_start[i + 1] as usize]
     }
 
     /// True when node `i` has no children.
@@ -236,8 +249,8 @@ impl CollisionShape {
             .fold(0.0, f32::max);
         Self {
             local_box: geometry.mesh.aabb(),
+            tree: Arc::new(CompactTree::new(tree, &geometry.mesh)),
             geometry,
-            tree: Arc::new(CompactTree::new(tree)),
             max_rho,
         }
     }

@@ -4,7 +4,12 @@
 //! Why the candidates suffice: a contact point of the two surfaces lies in some leaf of each tree
 //! (coverage invariant) and its triangle touches that leaf, and those two leaves' swept spheres meet
 //! at the contact time; so every pair of triangles that can touch during the step is a candidate
-//! pair, and no other pair touches at all.
+//! pair, and no other pair touches at all. The same argument narrows them further, which the
+//! hierarchical search does (its leaves hold dozens of triangles at scan resolution): a triangle
+//! of a leaf can only touch the other tooth at a point inside one of the other's leaves that meets
+//! this leaf, so only the triangles whose bounding spheres reach such a partner's sphere, swept
+//! over the rest of the motion (placed at the middle of the time left and grown by both teeth's
+//! travel over half of it), are listed.
 //!
 //! Windows: the search starts at the earliest leaf time (no contact can happen before it). When no
 //! point moves more than 1 mm in the rest of the step (short steps near contact) the rest is

@@ -20,7 +20,7 @@ use glam::Vec3;
 use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::geometry::{Aabb, NO_PARENT, TriMesh, TriangleBvh};
+use crate::geometry::{Aabb, NO_PARENT, Sphere, TriMesh, TriangleBvh};
 
 /// A node of a patch: an inner node's two children, or a leaf's range of [`Patch::order`].
 #[derive(Clone, Copy, Debug)]
@@ -81,12 +81,20 @@ impl Patch {
         self.leaves = 0;
     }
 
-    /// Lists the triangles of sphere-tree leaf `leaf` as candidates (each triangle once, each
-    /// remembering this leaf) and marks the hierarchy above them: the leaf's number.
+    /// The number of sphere-tree leaf `leaf`, listed before by [`Self::list_leaf`].
+    pub(super) fn leaf_number(&mut self, leaf: usize) -> u32 {
+        self.leaf_number.get(leaf, || u32::MAX)
+    }
+
+    /// Lists the triangles of sphere-tree leaf `leaf` that reach one of the spheres `near` (the
+    /// other tooth's leaves meeting this one, swept over the motion, in this tooth's frame) as
+    /// candidates (each triangle once, each remembering this leaf) and marks the hierarchy above
+    /// them: the leaf's number. A leaf listed before keeps its first listing.
     pub(super) fn list_leaf(
         &mut self,
         tree: &CompactTree,
         leaf: usize,
+        near: &[Sphere],
         mesh: &TriMesh,
         bvh: &TriangleBvh,
     ) -> u32 {
@@ -96,7 +104,13 @@ impl Patch {
         let number = self.leaves;
         self.leaves += 1;
         self.leaf_number.set(leaf, number);
-        for &x in tree.triangles(leaf) {
+        // A partner holding the whole leaf sphere passes every triangle touching it.
+        let s = tree.spheres[leaf];
+        let all = (near.iter()).any(|p| p.centre.distance(s.centre) + s.radius <= p.radius);
+        for (&x, t) in tree.triangles(leaf).iter().zip(tree.triangle_spheres(leaf)) {
+            if !all && !near.iter().any(|p| p.overlaps(t)) {
+                continue;
+            }
             if self.cand.has(x as usize) {
                 let c = self.cand.get(x as usize, || 0) as usize;
                 self.links.push((number, self.heads[c]));

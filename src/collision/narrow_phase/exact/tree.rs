@@ -7,10 +7,13 @@ use glam::{Mat3, Vec3};
 use super::drift::Drift;
 use super::patch::{Patch, PatchNode};
 use super::{Candidates, Frame, PlacedTri, Settle, advance_over, relative};
+use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
 use crate::collision::narrow_phase::{Body, PairContact, continuous};
-use crate::geometry::{Aabb, TriMesh, closest_points_facing_triangles, triangles_within};
+use crate::geometry::{
+    Aabb, Pose, Sphere, TriMesh, closest_points_facing_triangles, triangles_within,
+};
 
 /// Per-thread scratch of the advancement, reused between queries.
 #[derive(Default)]
@@ -402,6 +405,82 @@ impl Search<'_, '_> {
     }
 }
 
+/// Lists each tooth's candidates from the meeting leaf pairs of `swept` (the motion searched from
+/// `t`, the earliest leaf time) into the patches of `s`, builds their hierarchies and marks the
+/// meeting leaf pairs.
+fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64, s: &mut Scratch) {
+    let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
+    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+    let (ma, mb) = (&ga.mesh, &gb.mesh);
+    // Candidate triangles of each side: those of the leaves in the meeting leaf pairs, each once,
+    // each keeping the list of its meeting leaves, so that only the triangle pairs of meeting
+    // leaf pairs count (as in the flat advancement): two teeth resting within the tolerance where
+    // their leaves do not meet are not a contact.
+    //
+    // A leaf's triangle can only touch the other tooth inside one of the other's leaves that
+    // meets it (coverage invariant): so each leaf lists only its triangles whose bounding
+    // spheres reach one of those leaves' spheres, swept over the rest of the motion. From the
+    // middle of [t, 1] no point of either tooth moves more than half its speed bound times the
+    // length, so each partner is placed there and grown by both teeth's travel (and far more than
+    // the f32 rounding of the placement).
+    s.pa.begin(ma, &ga.bvh, ta.spheres.len());
+    s.pb.begin(mb, &gb.bvh, tb.spheres.len());
+    let mid = relative(&a.motion, &b.motion, 0.5 * (t + 1.0));
+    let (a_to_b, b_to_a) = (
+        mid.pose_b.inverse().mul(&mid.pose_a),
+        mid.pose_a.inverse().mul(&mid.pose_b),
+    );
+    let travel =
+        a.motion.speed_bound(a.shape.max_rho as f64) + b.motion.speed_bound(b.shape.max_rho as f64);
+    let grow = (0.5 * travel * (1.0 - t)) as f32 * (1.0 + 1e-4)
+        + 1e-3
+        + 1e-5 * (a.shape.max_rho + b.shape.max_rho + a_to_b.translation.length());
+    let swept_sphere = |tree: &CompactTree, leaf: u32, map: &Pose| {
+        let s = tree.spheres[leaf as usize];
+        Sphere::new(map.transform_point(s.centre), s.radius + grow)
+    };
+    let mut near = Vec::new();
+    let mut pairs: Vec<(u32, u32)> = swept.leaf_times.iter().map(|&(i, j, _)| (i, j)).collect();
+    pairs.sort_unstable();
+    for group in pairs.chunk_by(|x, y| x.0 == y.0) {
+        near.clear();
+        near.extend(group.iter().map(|p| swept_sphere(tb, p.1, &b_to_a)));
+        s.pa.list_leaf(ta, group[0].0 as usize, &near, ma, &ga.bvh);
+    }
+    pairs.sort_unstable_by_key(|p| (p.1, p.0));
+    for group in pairs.chunk_by(|x, y| x.1 == y.1) {
+        near.clear();
+        near.extend(group.iter().map(|p| swept_sphere(ta, p.0, &a_to_b)));
+        s.pb.list_leaf(tb, group[0].1 as usize, &near, mb, &gb.bvh);
+    }
+    let leaf_pairs: Vec<(u32, u32)> = (swept.leaf_times.iter())
+        .map(|&(i, j, _)| (s.pa.leaf_number(i as usize), s.pb.leaf_number(j as usize)))
+        .collect();
+    s.pa.build(&ga.bvh);
+    s.pb.build(&gb.bvh);
+    let leaves_b = s.pb.leaves as usize;
+    s.meets.clear();
+    s.meets
+        .resize((s.pa.leaves as usize * leaves_b).div_ceil(64), 0);
+    for (x, y) in leaf_pairs {
+        let bit = x as usize * leaves_b + y as usize;
+        s.meets[bit / 64] |= 1 << (bit % 64);
+    }
+}
+
+/// The candidate triangles (mesh triangle numbers) the hierarchical search lists for the meeting
+/// leaf pairs of `swept`, per tooth.
+#[cfg(test)]
+pub(super) fn candidates(a: &Body, b: &Body, swept: &continuous::SweptContact) -> [Vec<u32>; 2] {
+    let t = (swept.leaf_times.iter())
+        .map(|x| x.2)
+        .fold(f64::INFINITY, f64::min);
+    SCRATCH.with_borrow_mut(|s| {
+        list_candidates(a, b, swept, t, s);
+        [s.pa.ids.clone(), s.pb.ids.clone()]
+    })
+}
+
 fn advance_with(
     a: &Body,
     b: &Body,
@@ -417,28 +496,7 @@ fn advance_with(
         .iter()
         .map(|x| x.2)
         .fold(f64::INFINITY, f64::min);
-    // Candidate triangles of each side: those of the leaves in the meeting leaf pairs, each once,
-    // each keeping the list of its meeting leaves, so that only the triangle pairs of meeting
-    // leaf pairs count (as in the flat advancement): two teeth resting within the tolerance where
-    // their leaves do not meet are not a contact.
-    s.pa.begin(ma, &ga.bvh, ta.spheres.len());
-    s.pb.begin(mb, &gb.bvh, tb.spheres.len());
-    let mut leaf_pairs = Vec::with_capacity(swept.leaf_times.len());
-    for &(i, j, _) in &swept.leaf_times {
-        let x = s.pa.list_leaf(ta, i as usize, ma, &ga.bvh);
-        let y = s.pb.list_leaf(tb, j as usize, mb, &gb.bvh);
-        leaf_pairs.push((x, y));
-    }
-    s.pa.build(&ga.bvh);
-    s.pb.build(&gb.bvh);
-    let leaves_b = s.pb.leaves as usize;
-    s.meets.clear();
-    s.meets
-        .resize((s.pa.leaves as usize * leaves_b).div_ceil(64), 0);
-    for (x, y) in leaf_pairs {
-        let bit = x as usize * leaves_b + y as usize;
-        s.meets[bit / 64] |= 1 << (bit % 64);
-    }
+    list_candidates(a, b, swept, t, s);
     let speed = |motion: &crate::collision::Motion, mesh: &TriMesh, patch: &Patch| {
         motion.speed_bound_of(
             patch
