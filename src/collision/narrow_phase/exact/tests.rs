@@ -124,7 +124,7 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
     };
     let (a, b) = (tooth(16), tooth(15));
     let mut rng = Rng(0x11_57ed);
-    let (mut crossing, mut listed, mut in_leaves) = (0, [0; 2], [0; 2]);
+    let (mut crossing, mut listed, mut in_leaves, mut contacts) = (0, [0; 2], [0; 2], 0);
     for case in 0..60 {
         let ma = random_motion(&mut rng, &a.1, b.1.translation);
         // In every other step the second tooth moves too.
@@ -147,6 +147,8 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
             continue;
         };
         let [ca, cb] = super::tree::candidates(&body_a, &body_b, &swept);
+        // The search over them (which checks its leaf masks against the lists in tests).
+        contacts += query(&body_a, &body_b).is_some() as usize;
         // Steps searched whole (no point travels more than 1 mm), as near contact.
         let travel = ma.speed_bound(a.0.max_rho as f64) + mb.speed_bound(b.0.max_rho as f64);
         let short = (travel <= WHOLE_STEP_TRAVEL_MM) as usize;
@@ -185,7 +187,10 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
             }
         }
     }
-    eprintln!("crossing {crossing}, listed {listed:?} of {in_leaves:?} (long, short steps)");
+    eprintln!(
+        "crossing {crossing}, listed {listed:?} of {in_leaves:?} (long, short steps), {contacts} contacts"
+    );
+    assert!(contacts > 10, "{contacts}");
     assert!(crossing > 1000, "{crossing}");
     assert!(listed[0] < in_leaves[0], "{listed:?} of {in_leaves:?}");
     assert!(2 * listed[1] < in_leaves[1], "{listed:?} of {in_leaves:?}");

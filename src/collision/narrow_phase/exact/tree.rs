@@ -23,6 +23,12 @@ struct Scratch {
     pb: Patch,
     /// The meeting leaf pairs, one bit per (leaf of a, leaf of b) by their numbers.
     meets: Vec<u64>,
+    /// When the second tooth has at most 64 meeting leaves: per candidate of the first tooth, a
+    /// bit for each leaf of the second that one of its leaves meets; per candidate of the
+    /// second, a bit for each of its own leaves (so a pair meets when the two share a bit).
+    partners_a: Vec<u64>,
+    own_b: Vec<u64>,
+    masks: bool,
     /// Candidates placed in the first tooth's frame: the first's once per query, the second's
     /// once per step.
     placed_a: NodeCache<PlacedTri>,
@@ -143,6 +149,20 @@ impl Search<'_, '_> {
     /// Whether candidates `x` (first tooth) and `y` (second) lie in a meeting leaf pair.
     #[inline]
     fn meet(&self, x: u32, y: u32) -> bool {
+        if self.s.masks {
+            let m = self.s.partners_a[x as usize] & self.s.own_b[y as usize] != 0;
+            // The unit tests check the masks against the lists.
+            if cfg!(test) {
+                assert_eq!(m, self.meet_through_links(x, y), "pair ({x}, {y})");
+            }
+            return m;
+        }
+        self.meet_through_links(x, y)
+    }
+
+    /// [`Self::meet`] from the candidates' lists of leaves and the bit matrix of meeting leaf
+    /// pairs.
+    fn meet_through_links(&self, x: u32, y: u32) -> bool {
         let (pa, pb) = (&self.s.pa, &self.s.pb);
         let mut i = pa.heads[x as usize];
         while i != u32::MAX {
@@ -462,9 +482,33 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
     s.meets.clear();
     s.meets
         .resize((s.pa.leaves as usize * leaves_b).div_ceil(64), 0);
-    for (x, y) in leaf_pairs {
+    for &(x, y) in &leaf_pairs {
         let bit = x as usize * leaves_b + y as usize;
         s.meets[bit / 64] |= 1 << (bit % 64);
+    }
+    s.masks = leaves_b <= 64;
+    if s.masks {
+        // Each leaf of the first tooth's partners, then each candidate's through its leaves.
+        let mut rows = vec![0u64; s.pa.leaves as usize];
+        for &(x, y) in &leaf_pairs {
+            rows[x as usize] |= 1 << y;
+        }
+        let through = |patch: &Patch, c: usize, bit: &dyn Fn(u32) -> u64| {
+            let mut m = 0;
+            let mut i = patch.heads[c];
+            while i != u32::MAX {
+                let (leaf, next) = patch.links[i as usize];
+                m |= bit(leaf);
+                i = next;
+            }
+            m
+        };
+        s.partners_a.clear();
+        s.partners_a
+            .extend((0..s.pa.ids.len()).map(|c| through(&s.pa, c, &|leaf| rows[leaf as usize])));
+        s.own_b.clear();
+        s.own_b
+            .extend((0..s.pb.ids.len()).map(|c| through(&s.pb, c, &|leaf| 1 << leaf)));
     }
 }
 
