@@ -59,6 +59,16 @@ pub struct SweptContact {
     pub leaf_times: Vec<(u32, u32, f64)>,
 }
 
+impl SweptContact {
+    /// The earliest time any leaf pair meets (infinite when none is listed): no contact of the
+    /// meshes can happen before it.
+    pub fn earliest(&self) -> f64 {
+        (self.leaf_times.iter())
+            .map(|x| x.2)
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
 /// The interval test alone: false only when |A + B·t|² provably exceeds r² on all of [0, 1].
 #[inline]
 pub fn interval_may_meet(a: DVec3, b: DVec3, r: f64) -> bool {

@@ -164,11 +164,7 @@ pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
         return advance(a, b, &swept, tol);
     }
     let first = continuous::query(a, b, false)?;
-    let mut t = first
-        .leaf_times
-        .iter()
-        .map(|x| x.2)
-        .fold(f64::INFINITY, f64::min);
+    let mut t = first.earliest();
     let travel = whole * (1.0 - t);
     let mut window = if travel <= WHOLE_STEP_TRAVEL_MM {
         1.0 - t

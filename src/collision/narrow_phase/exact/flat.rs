@@ -87,11 +87,7 @@ fn advance_with(
         listed,
         candidates,
     } = scratch;
-    let t = swept
-        .leaf_times
-        .iter()
-        .map(|x| x.2)
-        .fold(f64::INFINITY, f64::min);
+    let t = swept.earliest();
     // Leaf pairs nearest first at the start, so that the first triangle pairs measured are near
     // ones and the bounds cull the rest.
     let start_rel = relative(&a.motion, &b.motion, t).rel;

@@ -163,9 +163,7 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
             side.dedup();
         }
         in_leaves[short] += all[0].len() + all[1].len();
-        let t0 = (swept.leaf_times.iter())
-            .map(|x| x.2)
-            .fold(f64::INFINITY, f64::min);
+        let t0 = swept.earliest();
         for k in 0..=8 {
             let t = (t0 + (1.0 - t0) * k as f64 / 8.0) as f32;
             let (pa, pb) = (ma.at(t), mb.at(t));

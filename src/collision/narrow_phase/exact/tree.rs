@@ -29,6 +29,8 @@ struct Scratch {
     partners_a: Vec<u64>,
     own_b: Vec<u64>,
     masks: bool,
+    /// Per meeting leaf of the first tooth, its partners' bits (while the masks are made).
+    rows: Vec<u64>,
     /// Candidates placed in the first tooth's frame: the first's once per query, the second's
     /// once per step.
     placed_a: NodeCache<PlacedTri>,
@@ -489,7 +491,9 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
     s.masks = leaves_b <= 64;
     if s.masks {
         // Each leaf of the first tooth's partners, then each candidate's through its leaves.
-        let mut rows = vec![0u64; s.pa.leaves as usize];
+        let mut rows = std::mem::take(&mut s.rows);
+        rows.clear();
+        rows.resize(s.pa.leaves as usize, 0);
         for &(x, y) in &leaf_pairs {
             rows[x as usize] |= 1 << y;
         }
@@ -509,6 +513,7 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
         s.own_b.clear();
         s.own_b
             .extend((0..s.pb.ids.len()).map(|c| through(&s.pb, c, &|leaf| 1 << leaf)));
+        s.rows = rows;
     }
 }
 
@@ -516,9 +521,7 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
 /// leaf pairs of `swept`, per tooth.
 #[cfg(test)]
 pub(super) fn candidates(a: &Body, b: &Body, swept: &continuous::SweptContact) -> [Vec<u32>; 2] {
-    let t = (swept.leaf_times.iter())
-        .map(|x| x.2)
-        .fold(f64::INFINITY, f64::min);
+    let t = swept.earliest();
     SCRATCH.with_borrow_mut(|s| {
         list_candidates(a, b, swept, t, s);
         [s.pa.ids.clone(), s.pb.ids.clone()]
@@ -535,11 +538,7 @@ fn advance_with(
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
     let (ma, mb) = (&ga.mesh, &gb.mesh);
-    let t = swept
-        .leaf_times
-        .iter()
-        .map(|x| x.2)
-        .fold(f64::INFINITY, f64::min);
+    let t = swept.earliest();
     list_candidates(a, b, swept, t, s);
     let speed = |motion: &crate::collision::Motion, mesh: &TriMesh, patch: &Patch| {
         motion.speed_bound_of(
