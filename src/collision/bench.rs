@@ -199,8 +199,10 @@ pub fn near_contact_pairs(
 pub struct MethodReport {
     /// Method name.
     pub method: String,
-    /// Mean time per pair query (µs, one core).
+    /// Median over [`METHOD_PASSES`] timed passes of the mean time per pair query (µs, one core).
     pub us_per_pair: f64,
+    /// Fastest and slowest of those passes (µs per pair).
+    pub range_us: [f64; 2],
     /// Contacts missed (see the module doc).
     pub false_negatives: usize,
     /// Contacts reported where the meshes stay apart.
@@ -311,6 +313,10 @@ fn mean(x: &[f64]) -> f64 {
     }
 }
 
+/// Timed passes per method of `orthosim bench`: on a shared machine one pass swings by 15 % and
+/// more, the median of five far less.
+pub const METHOD_PASSES: usize = 5;
+
 /// Every method on one set; `done(k)` after the reference and after each method.
 fn measure(
     teeth: &[BenchTooth],
@@ -337,14 +343,19 @@ fn measure(
             .iter()
             .map(|&(i, j, ma, mb)| query(method, &body(&teeth[i], ma), &body(&teeth[j], mb)))
             .collect();
-        results.clear();
-        let start = Instant::now();
-        results.extend(
-            pairs
-                .iter()
-                .map(|&(i, j, ma, mb)| query(method, &body(&teeth[i], ma), &body(&teeth[j], mb))),
-        );
-        let us_per_pair = start.elapsed().as_secs_f64() * 1e6 / pairs.len().max(1) as f64;
+        let mut times = Vec::with_capacity(METHOD_PASSES);
+        for _ in 0..METHOD_PASSES {
+            results.clear();
+            let start = Instant::now();
+            results.extend(
+                pairs.iter().map(|&(i, j, ma, mb)| {
+                    query(method, &body(&teeth[i], ma), &body(&teeth[j], mb))
+                }),
+            );
+            times.push(start.elapsed().as_secs_f64() * 1e6 / pairs.len().max(1) as f64);
+        }
+        times.sort_by(f64::total_cmp);
+        let us_per_pair = times[times.len() / 2];
         let discrete = matches!(method, Method::Circles | Method::Spheres);
         let (mut fneg, mut fpos, mut errors) = (0, 0, Vec::new());
         for (p, r) in results.iter().enumerate() {
@@ -373,6 +384,7 @@ fn measure(
         methods.push(MethodReport {
             method: method.name().into(),
             us_per_pair,
+            range_us: [times[0], times[times.len() - 1]],
             false_negatives: fneg,
             false_positives: fpos,
             mean_error_mm: mean(&errors),
