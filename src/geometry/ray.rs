@@ -74,6 +74,62 @@ pub(super) fn ray_parity(m: MeshRef, origin: Vec3, dir: Vec3) -> Option<bool> {
     Some(crossings % 2 == 1)
 }
 
+/// Triangles that segments are tested against ([`SegmentTargets::parity`]), ordered so that each
+/// run of [`Self::RUN`] lies close together (a median split of their centres along the widest
+/// extent, repeated), each run under one box: a short segment meets few runs' boxes.
+pub(super) struct SegmentTargets {
+    triangles: Vec<([Vec3; 3], Aabb)>,
+    runs: Vec<Aabb>,
+}
+
+impl SegmentTargets {
+    const RUN: usize = 8;
+
+    pub(super) fn new(mut triangles: Vec<([Vec3; 3], Aabb)>) -> Self {
+        fn order(list: &mut [([Vec3; 3], Aabb)]) {
+            if list.len() <= SegmentTargets::RUN {
+                return;
+            }
+            let bound = (list.iter()).fold(Aabb::EMPTY, |b, t| {
+                b.union(Aabb::from_points([t.1.centre()]))
+            });
+            let axis = (bound.max - bound.min).max_position();
+            let mid = (list.len() / 2).div_ceil(SegmentTargets::RUN) * SegmentTargets::RUN;
+            list.select_nth_unstable_by(mid, |x, y| {
+                x.1.centre()[axis].total_cmp(&y.1.centre()[axis])
+            });
+            let (left, right) = list.split_at_mut(mid);
+            order(left);
+            order(right);
+        }
+        order(&mut triangles);
+        let runs = (triangles.chunks(Self::RUN))
+            .map(|run| run.iter().fold(Aabb::EMPTY, |b, t| b.union(t.1)))
+            .collect();
+        Self { triangles, runs }
+    }
+
+    /// Parity of the crossings of the segment from `p` to `q` with the triangles, or None when
+    /// it passes within 10⁻⁶ (barycentric) of one's edge, ends within 10⁻⁴ of its length from
+    /// one's plane, or runs parallel to one's plane across its box: cases the parity cannot be
+    /// trusted in. The same answer as [`segment_parity`] over the triangles in any order.
+    pub(super) fn parity(&self, p: Vec3, q: Vec3) -> Option<bool> {
+        let span = Aabb {
+            min: p.min(q),
+            max: p.max(q),
+        };
+        let mut odd = false;
+        for (k, run) in self.runs.iter().enumerate() {
+            if run.distance_squared(&span) > 0.0 {
+                continue;
+            }
+            let end = (Self::RUN * (k + 1)).min(self.triangles.len());
+            odd ^= segment_parity(p, q, &self.triangles[Self::RUN * k..end])?;
+        }
+        Some(odd)
+    }
+}
+
 /// Parity of the crossings of the segment from `p` to `q` with `triangles` (each with its box),
 /// or None when it passes within 10⁻⁶ (barycentric) of one's edge, ends within 10⁻⁴ of its
 /// length from one's plane, or runs parallel to one's plane across its box: cases the parity
@@ -174,6 +230,42 @@ mod tests {
             parity(Vec3::new(0.5, 0.5, 1.0), Vec3::new(3.5, 0.5, 1.0)),
             None
         );
+    }
+
+    /// The grouped targets give the plain parity of every segment, trusted or not, over a
+    /// closed mesh of many small triangles (segments of all lengths, from inside and outside).
+    #[test]
+    fn grouped_targets_count_as_the_plain_list() {
+        use crate::teeth::{Arch, ToothGeometry, ToothKind, ToothResolution};
+        let g =
+            ToothGeometry::procedural(Arch::Upper, ToothKind::FirstMolar, ToothResolution::PAPER);
+        let faces: Vec<_> = (0..g.mesh.triangles.len())
+            .map(|i| {
+                let v = g.mesh.triangle(i);
+                (v, Aabb::from_points(v))
+            })
+            .collect();
+        assert!(faces.len() > 8 * SegmentTargets::RUN);
+        let grouped = SegmentTargets::new(faces.clone());
+        let bound = g.bvh.root_aabb();
+        let mut n = crate::geometry::test_numbers(7);
+        let mut point = || bound.centre() + Vec3::new(n(), n(), n()) * (bound.max - bound.min);
+        let (mut odd, mut untrusted) = (0, 0);
+        for k in 0..4000 {
+            let p = point();
+            // Short segments as the walk's, and long ones across the whole mesh.
+            let q = if k % 2 == 0 {
+                p + (point() - p) * 0.05
+            } else {
+                point()
+            };
+            let plain = segment_parity(p, q, &faces);
+            assert_eq!(grouped.parity(p, q), plain, "segment {p} to {q}");
+            odd += (plain == Some(true)) as usize;
+            untrusted += plain.is_none() as usize;
+        }
+        assert!(odd > 100, "{odd} odd");
+        eprintln!("{odd} odd, {untrusted} untrusted");
     }
 
     /// The first hit is the nearest face along the ray, past `t_min`; a ray from a face

@@ -7,7 +7,7 @@ use super::{
     aabb::Aabb,
     mesh_distance::{Deepest, MeshRef},
     pose::Pose,
-    ray::segment_parity,
+    ray::SegmentTargets,
     stars::VertexStars,
 };
 
@@ -44,13 +44,15 @@ pub struct NearContact<'a> {
 ///   segment's crossings with them; a segment that passes within 10⁻⁶ (barycentric) of one of
 ///   their edges or ends within 10⁻⁴ of its length from one of their planes is not trusted, and
 ///   the sample is tested by rays through the whole mesh instead, as every sample is when the
-///   list is long.
+///   list is long. The list is kept in runs of nearby triangles under one box each
+///   ([`SegmentTargets`]), so a short segment is tested against few of them.
 /// - **Depths bounded by the neighbour's.** The distance to a surface changes by at most the
 ///   distance moved, and a segment that enters the other mesh crosses its surface; so a sample's
 ///   depth is at most its inside neighbour's (or bound) plus the segment's length, or the length
 ///   alone from an outside neighbour. A sample whose bound does not exceed the deepest so far
 ///   cannot be the deepest and is not measured; one that can is measured only among the surface
-///   points within its bound.
+///   points within its bound. The nearest surface point of the last sample measured bounds the
+///   depth as well (it lies on the other surface), and the walk keeps it near.
 pub fn mesh_penetration_near(
     a: NearContact,
     pose_a: &Pose,
@@ -80,7 +82,7 @@ struct Walk<'a> {
     a: NearContact<'a>,
     /// The other side's near triangles (its frame) with their boxes, when few enough to carry
     /// sides along segments.
-    others: Option<Vec<([Vec3; 3], Aabb)>>,
+    others: Option<SegmentTargets>,
     side: Vec<Side>,
     seen_triangle: Vec<bool>,
     inside: Vec<u32>,
@@ -90,13 +92,15 @@ struct Walk<'a> {
 impl<'a> Walk<'a> {
     fn new(a: &NearContact<'a>, pose_a: &Pose, b: &NearContact<'a>, pose_b: &Pose) -> Self {
         let others = (b.near.len() <= CARRY_LIMIT).then(|| {
-            b.near
-                .iter()
-                .map(|&t| {
-                    let v = b.mesh.mesh.triangle(t as usize);
-                    (v, Aabb::from_points(v))
-                })
-                .collect()
+            SegmentTargets::new(
+                b.near
+                    .iter()
+                    .map(|&t| {
+                        let v = b.mesh.mesh.triangle(t as usize);
+                        (v, Aabb::from_points(v))
+                    })
+                    .collect(),
+            )
         });
         Self {
             a: *a,
@@ -170,10 +174,7 @@ impl<'a> Walk<'a> {
     /// The side of the point `p` (b's frame) reached from vertex `from` (side known, at `start`)
     /// along the segment between them, measuring its depth when inside.
     fn sample(&mut self, from: u32, start: Vec3, p: Vec3) -> Side {
-        let carried = self
-            .others
-            .as_ref()
-            .and_then(|o| segment_parity(start, p, o));
+        let carried = self.others.as_ref().and_then(|o| o.parity(start, p));
         let length = start.distance(p) * (1.0 + 1e-5) + 1e-6;
         let bound = match (carried, self.side[from as usize]) {
             (Some(false), Side::Outside) => return Side::Outside,
