@@ -410,7 +410,8 @@ impl TriMesh {
         open
     }
 
-    /// The same surface without the vertices no triangle uses (the rest keep their order).
+    /// The same surface without the vertices no triangle uses, the rest numbered in order of
+    /// first use by the triangles.
     pub fn without_unused_vertices(&self) -> Self {
         let mut map = vec![u32::MAX; self.vertices.len()];
         let mut vertices = Vec::with_capacity(self.vertices.len());
@@ -428,6 +429,16 @@ impl TriMesh {
             })
             .collect();
         Self::new(vertices, triangles)
+    }
+
+    /// The same surface with its triangles in `order` (a permutation of their indices) and its
+    /// vertices renumbered in order of first use (unused ones dropped). Listed in a hierarchy's
+    /// leaf order, the triangles of one patch of the surface, and their vertices, lie together in
+    /// memory, so a query reading a patch reads a few cache lines instead of one per corner.
+    pub fn in_triangle_order(&self, order: &[u32]) -> Self {
+        debug_assert_eq!(order.len(), self.triangles.len());
+        let triangles = order.iter().map(|&t| self.triangles[t as usize]).collect();
+        Self::new(self.vertices.clone(), triangles).without_unused_vertices()
     }
 
     /// A copy with every vertex mapped by `f` (e.g. a pose).
@@ -605,5 +616,26 @@ pub(crate) mod tests {
             m.validate_solid(),
             Err(MeshError::SelfIntersecting { .. })
         ));
+    }
+    #[test]
+    fn reordering_keeps_the_surface_and_numbers_vertices_by_first_use() {
+        let mut m = cuboid(Vec3::ZERO, Vec3::new(2.0, 3.0, 4.0));
+        // An unused vertex, dropped by the reorder.
+        m.vertices.push(Vec3::splat(9.0));
+        let order: Vec<u32> = (0..m.triangles.len() as u32).rev().collect();
+        let r = m.in_triangle_order(&order);
+        assert_eq!(r.vertices.len(), 8);
+        assert_eq!(r.triangles.len(), m.triangles.len());
+        assert!((r.validate_solid().unwrap().volume - 24.0).abs() < 1e-9);
+        // Triangle k of the result is triangle order[k] of the input, same corners in turn.
+        for (k, &t) in order.iter().enumerate() {
+            assert_eq!(r.triangle(k), m.triangle(t as usize));
+        }
+        // First use numbers the vertices 0, 1, 2, … as the triangles are read.
+        let mut next = 0;
+        for &i in r.triangles.iter().flatten() {
+            assert!(i <= next);
+            next = next.max(i + 1);
+        }
     }
 }

@@ -62,6 +62,9 @@ impl ToothGeometry {
             Vec3::Z,
             CentreParameters::default(),
         );
+        // Triangles and vertices in the hierarchy's leaf order: the surface's patches lie
+        // together in memory (see [`TriMesh::in_triangle_order`]), whatever order the file had.
+        let mesh = mesh.in_triangle_order(&TriangleBvh::build(&mesh).order);
         let bvh = TriangleBvh::build(&mesh);
         let stars = VertexStars::of(&mesh);
         Self {
