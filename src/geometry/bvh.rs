@@ -122,6 +122,23 @@ impl TriangleBvh {
         self.split(left + 1, mid, hi, boxes, centres);
     }
 
+    /// The same hierarchy over the mesh with its triangles in this hierarchy's leaf order
+    /// (`mesh.in_triangle_order(&self.order)`, see [`TriMesh::in_triangle_order`]): triangle k of
+    /// that mesh is triangle `order[k]` of this one, so the nodes and their boxes stand and only
+    /// the numbering changes; no rebuild.
+    pub fn in_leaf_order(&self) -> Self {
+        Self {
+            nodes: self.nodes.clone(),
+            order: (0..self.order.len() as u32).collect(),
+            parent: self.parent.clone(),
+            leaf_of: self
+                .order
+                .iter()
+                .map(|&t| self.leaf_of[t as usize])
+                .collect(),
+        }
+    }
+
     /// The triangles of a leaf node.
     #[inline]
     pub fn leaf_triangles(&self, node: &BvhNode) -> &[u32] {
@@ -200,7 +217,23 @@ mod tests {
     #[test]
     fn parents_and_leaves_hold_their_triangles() {
         let mesh = sheet(12);
+        holds_its_triangles(&mesh, &TriangleBvh::build(&mesh));
+    }
+
+    /// The hierarchy carried over to the mesh in its leaf order holds that mesh's triangles as a
+    /// hierarchy built for it would, and reads its leaves in plain order.
+    #[test]
+    fn a_hierarchy_carries_over_to_its_leaf_order() {
+        let mesh = sheet(12);
         let bvh = TriangleBvh::build(&mesh);
+        assert!(bvh.order.windows(2).any(|w| w[0] > w[1]));
+        let ordered = mesh.in_triangle_order(&bvh.order);
+        let carried = bvh.in_leaf_order();
+        holds_its_triangles(&ordered, &carried);
+        assert!(carried.order.windows(2).all(|w| w[0] + 1 == w[1]));
+    }
+
+    fn holds_its_triangles(mesh: &TriMesh, bvh: &TriangleBvh) {
         assert!(bvh.nodes.len() > 7);
         assert_eq!(bvh.parent[0], NO_PARENT);
         for t in 0..mesh.triangles.len() as u32 {

@@ -64,8 +64,9 @@ impl ToothGeometry {
         );
         // Triangles and vertices in the hierarchy's leaf order: the surface's patches lie
         // together in memory (see [`TriMesh::in_triangle_order`]), whatever order the file had.
-        let mesh = mesh.in_triangle_order(&TriangleBvh::build(&mesh).order);
         let bvh = TriangleBvh::build(&mesh);
+        let mesh = mesh.in_triangle_order(&bvh.order);
+        let bvh = bvh.in_leaf_order();
         let stars = VertexStars::of(&mesh);
         Self {
             arch,
