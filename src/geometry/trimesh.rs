@@ -617,6 +617,7 @@ pub(crate) mod tests {
             Err(MeshError::SelfIntersecting { .. })
         ));
     }
+
     #[test]
     fn reordering_keeps_the_surface_and_numbers_vertices_by_first_use() {
         let mut m = cuboid(Vec3::ZERO, Vec3::new(2.0, 3.0, 4.0));
