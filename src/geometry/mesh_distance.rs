@@ -194,7 +194,12 @@ pub fn closest_point_on_mesh(m: MeshRef, p: Vec3) -> Option<(Vec3, f32)> {
 /// [`closest_point_on_mesh`] among the surface points nearer than `limit` (None if there are
 /// none): boxes farther than the limit are never opened.
 pub fn closest_point_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(Vec3, f32)> {
-    let mut best: Option<(Vec3, f32)> = None;
+    closest_on_mesh_within(m, p, limit).map(|(q, d, _)| (q, d))
+}
+
+/// [`closest_point_on_mesh_within`] with the number of the triangle the point lies on.
+fn closest_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(Vec3, f32, u32)> {
+    let mut best: Option<(Vec3, f32, u32)> = None;
     let mut best_d2 = limit * limit;
     if m.bvh.nodes.is_empty() {
         return None;
@@ -221,7 +226,7 @@ pub fn closest_point_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(
                 let d2 = q.distance_squared(p);
                 if d2 < best_d2 {
                     best_d2 = d2;
-                    best = Some((q, d2.sqrt()));
+                    best = Some((q, d2.sqrt(), t));
                 }
             }
         } else {
@@ -362,9 +367,9 @@ pub(super) struct Deepest<'a> {
     b_box: Aabb,
     /// Depth, deepest point (b's frame) and its nearest point on b's surface (b's frame).
     best: (f32, Vec3, Vec3),
-    /// The nearest surface point of the last sample measured (b's frame): a point of b's
-    /// surface, so no sample is deeper than its distance from it.
-    last: Option<Vec3>,
+    /// The triangle of b's surface (b's frame) nearest the last sample measured: no sample is
+    /// deeper than its distance from it.
+    last: Option<[Vec3; 3]>,
 }
 
 impl<'a> Deepest<'a> {
@@ -402,25 +407,27 @@ impl<'a> Deepest<'a> {
     /// it could exceed the deepest so far (the deepest is kept), else an upper bound of it is
     /// returned. The deepest found is the same as measuring every sample.
     ///
-    /// The last sample's nearest surface point bounds the depth too (it lies on b's surface, up
-    /// to the rounding of the closest-point query, which the margins of 10⁻⁵ cover many times),
-    /// and samples come in walking order, so it is usually near: it prunes samples shallower than
-    /// the deepest and narrows the search of the others.
+    /// The triangle of b's surface nearest the last sample measured bounds the depth too: the
+    /// distance to its nearest point (which lies on b's surface, up to the rounding of the
+    /// closest-point query, which the margins of 10⁻⁵ cover many times). Samples come in walking
+    /// order, so it is usually the sample's own nearest triangle or beside it, and the bound is
+    /// then the depth itself or close above it: it prunes samples shallower than the deepest and
+    /// narrows the search of the others.
     pub(super) fn depth(&mut self, p: Vec3, bound: f32) -> f32 {
-        let near = self
-            .last
-            .map_or(f32::INFINITY, |q| p.distance(q) * (1.0 + 1e-5) + 1e-5);
+        let near = self.last.map_or(f32::INFINITY, |[a, b, c]| {
+            p.distance(closest_point_triangle(p, a, b, c)) * (1.0 + 1e-5) + 1e-5
+        });
         let bound = bound.min(near);
         if bound <= self.best.0 {
             return bound;
         }
         let limit = bound * (1.0 + 1e-5) + 1e-5;
-        let Some((q, d)) = closest_point_on_mesh_within(self.b, p, limit)
-            .or_else(|| closest_point_on_mesh(self.b, p))
+        let Some((q, d, t)) = closest_on_mesh_within(self.b, p, limit)
+            .or_else(|| closest_on_mesh_within(self.b, p, f32::INFINITY))
         else {
             return bound;
         };
-        self.last = Some(q);
+        self.last = Some(self.b.mesh.triangle(t as usize));
         if d > self.best.0 {
             self.best = (d, p, q);
         }
