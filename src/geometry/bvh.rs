@@ -38,6 +38,8 @@ pub struct TriangleBvh {
     pub parent: Vec<u32>,
     /// The leaf holding each triangle.
     pub leaf_of: Vec<u32>,
+    /// The place of each triangle in `order`.
+    pub position: Vec<u32>,
 }
 
 /// [`TriangleBvh::parent`] of the root.
@@ -55,6 +57,7 @@ impl TriangleBvh {
             order: (0..mesh.triangles.len() as u32).collect(),
             parent: Vec::new(),
             leaf_of: vec![0; mesh.triangles.len()],
+            position: vec![0; mesh.triangles.len()],
         };
         if mesh.triangles.is_empty() {
             return bvh;
@@ -66,6 +69,9 @@ impl TriangleBvh {
         });
         let n = bvh.order.len();
         bvh.split(0, 0, n, &boxes, &centres);
+        for (k, &t) in bvh.order.iter().enumerate() {
+            bvh.position[t as usize] = k as u32;
+        }
         bvh.parent = vec![NO_PARENT; bvh.nodes.len()];
         for (k, node) in bvh.nodes.iter().enumerate() {
             if node.is_leaf() {
@@ -84,14 +90,14 @@ impl TriangleBvh {
         let aabb = self.order[lo..hi]
             .iter()
             .fold(Aabb::EMPTY, |b, &t| b.union(boxes[t as usize]));
-        if hi - lo <= LEAF_SIZE {
+        let Some(mid) = Self::split_of(lo, hi) else {
             self.nodes[node] = BvhNode {
                 aabb,
                 start: lo as u32,
                 count: (hi - lo) as u32,
             };
             return;
-        }
+        };
         let cb = Aabb::from_points(self.order[lo..hi].iter().map(|&t| centres[t as usize]));
         let e = cb.extent();
         let axis = if e.x >= e.y && e.x >= e.z {
@@ -101,7 +107,6 @@ impl TriangleBvh {
         } else {
             2
         };
-        let mid = (lo + hi) / 2;
         self.order[lo..hi].select_nth_unstable_by(mid - lo, |&a, &b| {
             centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
         });
@@ -122,6 +127,16 @@ impl TriangleBvh {
         self.split(left + 1, mid, hi, boxes, centres);
     }
 
+    /// How the node holding the places `lo..hi` of [`Self::order`] splits them (the root holds
+    /// all of `order`): `None` for a leaf (`lo..hi` is then `start..start + count`), else `mid`,
+    /// its first child holding `lo..mid` and its second `mid..hi`. So the shape of the hierarchy
+    /// follows from the number of triangles alone, and the node holding a triangle from its
+    /// place.
+    #[inline]
+    pub fn split_of(lo: usize, hi: usize) -> Option<usize> {
+        (hi - lo > LEAF_SIZE).then_some((lo + hi) / 2)
+    }
+
     /// The same hierarchy over the mesh with its triangles in this hierarchy's leaf order
     /// (`mesh.in_triangle_order(&self.order)`, see [`TriMesh::in_triangle_order`]): triangle k of
     /// that mesh is triangle `order[k]` of this one, so the nodes and their boxes stand and only
@@ -130,6 +145,7 @@ impl TriangleBvh {
         Self {
             nodes: self.nodes.clone(),
             order: (0..self.order.len() as u32).collect(),
+            position: (0..self.order.len() as u32).collect(),
             parent: self.parent.clone(),
             leaf_of: self
                 .order
@@ -236,6 +252,28 @@ mod tests {
     fn holds_its_triangles(mesh: &TriMesh, bvh: &TriangleBvh) {
         assert!(bvh.nodes.len() > 7);
         assert_eq!(bvh.parent[0], NO_PARENT);
+        // Each node holds the places of `order` that the splits give it, and `position` inverts
+        // `order`.
+        let mut stack = vec![(0u32, 0, bvh.order.len())];
+        let mut leaves = 0;
+        while let Some((n, lo, hi)) = stack.pop() {
+            let node = bvh.nodes[n as usize];
+            match TriangleBvh::split_of(lo, hi) {
+                None => {
+                    assert!(node.is_leaf());
+                    assert_eq!((node.start as usize, node.count as usize), (lo, hi - lo));
+                    leaves += hi - lo;
+                }
+                Some(mid) => {
+                    assert!(!node.is_leaf() && lo < mid && mid < hi);
+                    stack.extend([(node.start, lo, mid), (node.start + 1, mid, hi)]);
+                }
+            }
+        }
+        assert_eq!(leaves, mesh.triangles.len());
+        for (k, &t) in bvh.order.iter().enumerate() {
+            assert_eq!(bvh.position[t as usize], k as u32);
+        }
         for t in 0..mesh.triangles.len() as u32 {
             let mut n = bvh.leaf_of[t as usize];
             assert!(bvh.leaf_triangles(&bvh.nodes[n as usize]).contains(&t));

@@ -20,7 +20,7 @@ use glam::Vec3;
 use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::geometry::{Aabb, NO_PARENT, Sphere, TriMesh, TriangleBvh};
+use crate::geometry::{Aabb, Sphere, TriMesh, TriangleBvh};
 
 /// A node of a patch: an inner node's two children, or a leaf's range of [`Patch::order`].
 #[derive(Clone, Copy, Debug)]
@@ -30,6 +30,16 @@ pub(super) struct PatchNode {
     /// Inner: the second child; leaf: the number of entries.
     pub(super) b: u32,
     pub(super) leaf: bool,
+}
+
+/// A node of the stored hierarchy still to descend while a patch is built: the places of the
+/// hierarchy's order it holds, the run of sorted candidates among them, and the patch node it
+/// fills.
+#[derive(Clone, Copy, Debug, Default)]
+struct Pending {
+    places: (u32, u32),
+    run: (u32, u32),
+    slot: u32,
 }
 
 /// One tooth's candidate triangles, their hierarchy and their boxes in the search frame.
@@ -53,23 +63,24 @@ pub(super) struct Patch {
     framed: Vec<Vec3>,
     pub(super) tri_box: Vec<Aabb>,
     pub(super) node_box: Vec<Aabb>,
-    /// Per mesh triangle, vertex, hierarchy node and sphere-tree leaf: its candidate number,
-    /// its place in `vertices`, whether it holds a candidate, the leaf's number.
+    /// Per mesh triangle, vertex and sphere-tree leaf: its candidate number, its place in
+    /// `vertices`, the leaf's number.
     cand: NodeCache<u32>,
     vertex_of: NodeCache<u32>,
-    marked: NodeCache<bool>,
     leaf_number: NodeCache<u32>,
+    /// The candidates by their triangles' places in the hierarchy's order (place, candidate),
+    /// while the hierarchy is built.
+    placed: Vec<(u32, u32)>,
+    stack: Vec<Pending>,
     /// Sphere-tree leaves numbered so far.
     pub(super) leaves: u32,
 }
 
 impl Patch {
-    /// Starts a query on a mesh with `triangles` triangles, `vertices` vertices, a hierarchy of
-    /// `nodes` nodes and a sphere tree of `spheres` nodes.
-    pub(super) fn begin(&mut self, mesh: &TriMesh, bvh: &TriangleBvh, spheres: usize) {
+    /// Starts a query on `mesh` with a sphere tree of `spheres` nodes.
+    pub(super) fn begin(&mut self, mesh: &TriMesh, spheres: usize) {
         self.cand.begin(mesh.triangles.len());
         self.vertex_of.begin(mesh.vertices.len());
-        self.marked.begin(bvh.nodes.len());
         self.leaf_number.begin(spheres);
         self.ids.clear();
         self.corners.clear();
@@ -88,15 +99,14 @@ impl Patch {
 
     /// Lists the triangles of sphere-tree leaf `leaf` that reach one of the spheres `near` (the
     /// other tooth's leaves meeting this one, swept over the motion, in this tooth's frame) as
-    /// candidates (each triangle once, each remembering this leaf) and marks the hierarchy above
-    /// them: the leaf's number. A leaf listed before keeps its first listing.
+    /// candidates (each triangle once, each remembering this leaf): the leaf's number. A leaf
+    /// listed before keeps its first listing.
     pub(super) fn list_leaf(
         &mut self,
         tree: &CompactTree,
         leaf: usize,
         near: &[Sphere],
         mesh: &TriMesh,
-        bvh: &TriangleBvh,
     ) -> u32 {
         if self.leaf_number.has(leaf) {
             return self.leaf_number.get(leaf, || 0);
@@ -131,70 +141,84 @@ impl Patch {
                 place
             });
             self.corners.push(corners);
-            let mut n = bvh.leaf_of[x as usize];
-            while n != NO_PARENT && !self.marked.has(n as usize) {
-                self.marked.set(n as usize, true);
-                n = bvh.parent[n as usize];
-            }
         }
         number
     }
 
-    /// Builds the patch's hierarchy from the marked part of `bvh` (after the listing).
+    /// Builds the patch's hierarchy (after the listing): the part of `bvh` above the
+    /// candidates, each node keeping only the candidates below it and a node with candidates
+    /// under one child alone giving way to that child.
+    ///
+    /// The shape of `bvh` follows from its places alone ([`TriangleBvh::split_of`]), so with the
+    /// candidates sorted by place each node's candidates are a run of them, split between its
+    /// children at the first place past the middle: the build reads no node of `bvh`.
     pub(super) fn build(&mut self, bvh: &TriangleBvh) {
         self.nodes.clear();
         self.order.clear();
         if self.ids.is_empty() {
             return;
         }
-        // (stored node, the patch node to fill); a node with one marked child is skipped.
-        let mut stack = vec![(0u32, 0u32)];
-        self.nodes.push(PatchNode {
+        self.placed.clear();
+        (self.placed).extend(
+            (self.ids.iter().enumerate()).map(|(c, &x)| (bvh.position[x as usize], c as u32)),
+        );
+        self.placed.sort_unstable();
+        let leaf = PatchNode {
             a: 0,
             b: 0,
             leaf: true,
+        };
+        self.nodes.push(leaf);
+        self.stack.clear();
+        self.stack.push(Pending {
+            places: (0, bvh.order.len() as u32),
+            run: (0, self.placed.len() as u32),
+            slot: 0,
         });
-        while let Some((mut n, slot)) = stack.pop() {
+        while let Some(mut p) = self.stack.pop() {
             loop {
-                let node = &bvh.nodes[n as usize];
-                if node.is_leaf() {
+                let run = &self.placed[p.run.0 as usize..p.run.1 as usize];
+                let Some(mid) = TriangleBvh::split_of(p.places.0 as usize, p.places.1 as usize)
+                else {
                     let start = self.order.len() as u32;
-                    for &x in bvh.leaf_triangles(node) {
-                        if self.cand.has(x as usize) {
-                            let c = self.cand.get(x as usize, || 0);
-                            self.order.push(c);
-                        }
-                    }
-                    self.nodes[slot as usize] = PatchNode {
+                    self.order.extend(run.iter().map(|&(_, c)| c));
+                    self.nodes[p.slot as usize] = PatchNode {
                         a: start,
-                        b: self.order.len() as u32 - start,
+                        b: run.len() as u32,
                         leaf: true,
                     };
                     break;
-                }
-                let (l, r) = (node.start, node.start + 1);
-                match (self.marked.has(l as usize), self.marked.has(r as usize)) {
-                    (true, true) => {
-                        let first = self.nodes.len() as u32;
-                        let leaf = PatchNode {
-                            a: 0,
-                            b: 0,
-                            leaf: true,
-                        };
-                        self.nodes.extend([leaf, leaf]);
-                        self.nodes[slot as usize] = PatchNode {
-                            a: first,
-                            b: first + 1,
-                            leaf: false,
-                        };
-                        stack.push((r, first + 1));
-                        stack.push((l, first));
-                        break;
-                    }
-                    (true, false) => n = l,
-                    (false, true) => n = r,
-                    // A marked inner node always holds a marked child.
-                    (false, false) => break,
+                };
+                let mid = mid as u32;
+                let split = p.run.0 + run.partition_point(|&(place, _)| place < mid) as u32;
+                let first = Pending {
+                    places: (p.places.0, mid),
+                    run: (p.run.0, split),
+                    slot: p.slot,
+                };
+                let second = Pending {
+                    places: (mid, p.places.1),
+                    run: (split, p.run.1),
+                    slot: p.slot,
+                };
+                if split == p.run.0 {
+                    p = second;
+                } else if split == p.run.1 {
+                    p = first;
+                } else {
+                    let slot = self.nodes.len() as u32;
+                    self.nodes.extend([leaf, leaf]);
+                    self.nodes[p.slot as usize] = PatchNode {
+                        a: slot,
+                        b: slot + 1,
+                        leaf: false,
+                    };
+                    self.stack.push(Pending {
+                        slot: slot + 1,
+                        ..second
+                    });
+                    self.stack.push(Pending { slot, ..first });
+                    break;
                 }
             }
         }

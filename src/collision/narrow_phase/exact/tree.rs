@@ -445,8 +445,8 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
     // middle of [t, 1] no point of either tooth moves more than half its speed bound times the
     // length, so each partner is placed there and grown by both teeth's travel (and far more than
     // the f32 rounding of the placement).
-    s.pa.begin(ma, &ga.bvh, ta.spheres.len());
-    s.pb.begin(mb, &gb.bvh, tb.spheres.len());
+    s.pa.begin(ma, ta.spheres.len());
+    s.pb.begin(mb, tb.spheres.len());
     let mid = relative(&a.motion, &b.motion, 0.5 * (t + 1.0));
     let (a_to_b, b_to_a) = (
         mid.pose_b.inverse().mul(&mid.pose_a),
@@ -467,13 +467,13 @@ fn list_candidates(a: &Body, b: &Body, swept: &continuous::SweptContact, t: f64,
     for group in pairs.chunk_by(|x, y| x.0 == y.0) {
         near.clear();
         near.extend(group.iter().map(|p| swept_sphere(tb, p.1, &b_to_a)));
-        s.pa.list_leaf(ta, group[0].0 as usize, &near, ma, &ga.bvh);
+        s.pa.list_leaf(ta, group[0].0 as usize, &near, ma);
     }
     pairs.sort_unstable_by_key(|p| (p.1, p.0));
     for group in pairs.chunk_by(|x, y| x.1 == y.1) {
         near.clear();
         near.extend(group.iter().map(|p| swept_sphere(ta, p.0, &a_to_b)));
-        s.pb.list_leaf(tb, group[0].1 as usize, &near, mb, &gb.bvh);
+        s.pb.list_leaf(tb, group[0].1 as usize, &near, mb);
     }
     let leaf_pairs: Vec<(u32, u32)> = (swept.leaf_times.iter())
         .map(|&(i, j, _)| (s.pa.leaf_number(i as usize), s.pb.leaf_number(j as usize)))
