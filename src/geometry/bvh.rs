@@ -34,16 +34,9 @@ pub struct TriangleBvh {
     pub nodes: Vec<BvhNode>,
     /// Triangle indices, grouped by leaf.
     pub order: Vec<u32>,
-    /// Parent of each node ([`NO_PARENT`] for the root).
-    pub parent: Vec<u32>,
-    /// The leaf holding each triangle.
-    pub leaf_of: Vec<u32>,
     /// The place of each triangle in `order`.
     pub position: Vec<u32>,
 }
-
-/// [`TriangleBvh::parent`] of the root.
-pub const NO_PARENT: u32 = u32::MAX;
 
 impl TriangleBvh {
     /// Builds the hierarchy for `mesh`'s triangles.
@@ -55,8 +48,6 @@ impl TriangleBvh {
         let mut bvh = Self {
             nodes: Vec::with_capacity(2 * mesh.triangles.len() / LEAF_SIZE + 1),
             order: (0..mesh.triangles.len() as u32).collect(),
-            parent: Vec::new(),
-            leaf_of: vec![0; mesh.triangles.len()],
             position: vec![0; mesh.triangles.len()],
         };
         if mesh.triangles.is_empty() {
@@ -71,17 +62,6 @@ impl TriangleBvh {
         bvh.split(0, 0, n, &boxes, &centres);
         for (k, &t) in bvh.order.iter().enumerate() {
             bvh.position[t as usize] = k as u32;
-        }
-        bvh.parent = vec![NO_PARENT; bvh.nodes.len()];
-        for (k, node) in bvh.nodes.iter().enumerate() {
-            if node.is_leaf() {
-                for &t in &bvh.order[node.start as usize..(node.start + node.count) as usize] {
-                    bvh.leaf_of[t as usize] = k as u32;
-                }
-            } else {
-                bvh.parent[node.start as usize] = k as u32;
-                bvh.parent[node.start as usize + 1] = k as u32;
-            }
         }
         bvh
     }
@@ -146,12 +126,6 @@ impl TriangleBvh {
             nodes: self.nodes.clone(),
             order: (0..self.order.len() as u32).collect(),
             position: (0..self.order.len() as u32).collect(),
-            parent: self.parent.clone(),
-            leaf_of: self
-                .order
-                .iter()
-                .map(|&t| self.leaf_of[t as usize])
-                .collect(),
         }
     }
 
@@ -228,10 +202,10 @@ mod tests {
         TriMesh::new(v, t)
     }
 
-    /// Parents and leaves agree with the nodes: every triangle sits in its leaf and under each of
-    /// its ancestors, whose boxes hold it.
+    /// The splits and places agree with the nodes: every triangle sits in the leaf its place
+    /// gives and under each of its ancestors, whose boxes hold it.
     #[test]
-    fn parents_and_leaves_hold_their_triangles() {
+    fn nodes_hold_the_triangles_their_places_give() {
         let mesh = sheet(12);
         holds_its_triangles(&mesh, &TriangleBvh::build(&mesh));
     }
@@ -251,42 +225,34 @@ mod tests {
 
     fn holds_its_triangles(mesh: &TriMesh, bvh: &TriangleBvh) {
         assert!(bvh.nodes.len() > 7);
-        assert_eq!(bvh.parent[0], NO_PARENT);
-        // Each node holds the places of `order` that the splits give it, and `position` inverts
-        // `order`.
-        let mut stack = vec![(0u32, 0, bvh.order.len())];
+        // Each node holds the places of `order` that the splits give it, and their triangles lie
+        // in its box; `position` inverts `order`.
+        let mut stack = vec![(0u32, 0, bvh.order.len(), 0)];
         let mut leaves = 0;
-        while let Some((n, lo, hi)) = stack.pop() {
+        while let Some((n, lo, hi, depth)) = stack.pop() {
             let node = bvh.nodes[n as usize];
+            for &t in &bvh.order[lo..hi] {
+                for v in mesh.triangle(t as usize) {
+                    let b = node.aabb;
+                    assert!(b.distance_squared_to_point(v) == 0.0, "{v} outside {b:?}");
+                }
+            }
             match TriangleBvh::split_of(lo, hi) {
                 None => {
-                    assert!(node.is_leaf());
+                    assert!(node.is_leaf() && depth >= 2);
                     assert_eq!((node.start as usize, node.count as usize), (lo, hi - lo));
                     leaves += hi - lo;
                 }
                 Some(mid) => {
                     assert!(!node.is_leaf() && lo < mid && mid < hi);
-                    stack.extend([(node.start, lo, mid), (node.start + 1, mid, hi)]);
+                    let d = depth + 1;
+                    stack.extend([(node.start, lo, mid, d), (node.start + 1, mid, hi, d)]);
                 }
             }
         }
         assert_eq!(leaves, mesh.triangles.len());
         for (k, &t) in bvh.order.iter().enumerate() {
             assert_eq!(bvh.position[t as usize], k as u32);
-        }
-        for t in 0..mesh.triangles.len() as u32 {
-            let mut n = bvh.leaf_of[t as usize];
-            assert!(bvh.leaf_triangles(&bvh.nodes[n as usize]).contains(&t));
-            let mut levels = 0;
-            while n != NO_PARENT {
-                let b = bvh.nodes[n as usize].aabb;
-                for v in mesh.triangle(t as usize) {
-                    assert!(b.distance_squared_to_point(v) == 0.0, "{v} outside {b:?}");
-                }
-                n = bvh.parent[n as usize];
-                levels += 1;
-            }
-            assert!(levels >= 2);
         }
     }
 }

@@ -25,7 +25,7 @@ pub(crate) mod trimesh;
 mod walk;
 
 pub use aabb::Aabb;
-pub use bvh::{NO_PARENT, TriangleBvh};
+pub use bvh::TriangleBvh;
 pub use closest::{
     FacePlane, TrianglePair, closest_point_triangle, closest_points_facing_triangles,
     closest_points_segment_segment, closest_points_triangle_triangle, plane_gap,
