@@ -51,8 +51,9 @@ pub struct NearContact<'a> {
 ///   depth is at most its inside neighbour's (or bound) plus the segment's length, or the length
 ///   alone from an outside neighbour. A sample whose bound does not exceed the deepest so far
 ///   cannot be the deepest and is not measured; one that can is measured only among the surface
-///   points within its bound. The nearest surface point of the last sample measured bounds the
-///   depth as well (it lies on the other surface), and the walk keeps it near.
+///   points within its bound. The distance to the other surface's triangle nearest the last
+///   sample measured bounds the depth as well, and the walk keeps that triangle near: often it
+///   is the sample's own nearest, so the bound is the depth itself.
 pub fn mesh_penetration_near(
     a: NearContact,
     pose_a: &Pose,
