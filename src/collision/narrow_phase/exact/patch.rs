@@ -35,7 +35,7 @@ pub(super) struct PatchNode {
 /// A node of the stored hierarchy still to descend while a patch is built: the places of the
 /// hierarchy's order it holds, the run of sorted candidates among them, and the patch node it
 /// fills.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct Pending {
     places: (u32, u32),
     run: (u32, u32),
@@ -70,7 +70,7 @@ pub(super) struct Patch {
     leaf_number: NodeCache<u32>,
     /// The candidates by their triangles' places in the hierarchy's order (place, candidate),
     /// while the hierarchy is built.
-    placed: Vec<(u32, u32)>,
+    by_place: Vec<(u32, u32)>,
     stack: Vec<Pending>,
     /// Sphere-tree leaves numbered so far.
     pub(super) leaves: u32,
@@ -158,11 +158,11 @@ impl Patch {
         if self.ids.is_empty() {
             return;
         }
-        self.placed.clear();
-        (self.placed).extend(
+        self.by_place.clear();
+        (self.by_place).extend(
             (self.ids.iter().enumerate()).map(|(c, &x)| (bvh.position[x as usize], c as u32)),
         );
-        self.placed.sort_unstable();
+        self.by_place.sort_unstable();
         let leaf = PatchNode {
             a: 0,
             b: 0,
@@ -172,12 +172,12 @@ impl Patch {
         self.stack.clear();
         self.stack.push(Pending {
             places: (0, bvh.order.len() as u32),
-            run: (0, self.placed.len() as u32),
+            run: (0, self.by_place.len() as u32),
             slot: 0,
         });
         while let Some(mut p) = self.stack.pop() {
             loop {
-                let run = &self.placed[p.run.0 as usize..p.run.1 as usize];
+                let run = &self.by_place[p.run.0 as usize..p.run.1 as usize];
                 let Some(mid) = TriangleBvh::split_of(p.places.0 as usize, p.places.1 as usize)
                 else {
                     let start = self.order.len() as u32;
