@@ -66,6 +66,10 @@
 //! way, a node pair being left closed when its plain bound or its drift along the direction (the
 //! boxes' extent along the frame's third axis) already allows
 //! the step. All node bounds are computed in f32 and lowered by far more than their rounding.
+//! The hierarchical search prunes a little (`NEAREST_SLACK`, 2 %) below its best so far, so it
+//! does not spend most of its node pairs proving that nothing is slightly nearer: the pair it
+//! finds is within that fraction of the least, and the plain step is taken from the pruning
+//! limit, which nothing left unmeasured is nearer than.
 //! Once the motion is under way (t > 0) the teeth cannot interpenetrate, so the hierarchical
 //! search stops at the first triangle pair within the tolerance and reports it: its gap is within
 //! the tolerance, the true least gap lies between half the tolerance and it, and the time is the
@@ -242,16 +246,18 @@ struct Settle<'x, 'y> {
 }
 
 impl Settle<'_, '_> {
-    /// The search found the gap `d` between `q` (first tooth's frame) at time `t`: within the
-    /// tolerance, or at the `last` step, the contact is reported here (still never after the
-    /// meshes' contact); otherwise every pair is at least d apart and closes at most μ per unit
-    /// time, so a plain step of (d − h)/μ keeps h, half the tolerance. The pairs near the
-    /// contact, which limit that step, usually separate along the closest direction much more
-    /// slowly than μ: the caller extends it as far as every pair allows (see [`drift::Drift`]).
+    /// The search found the gap `d` between `q` (first tooth's frame) at time `t`, and that no
+    /// candidate pair is nearer than `low` (at most d): within the tolerance, or at the `last`
+    /// step, the contact is reported here (still never after the meshes' contact); otherwise
+    /// every pair is at least `low` apart and closes at most μ per unit time, so a plain step of
+    /// (low − h)/μ keeps h, half the tolerance (the searches keep `low` above three quarters of d,
+    /// so above h). The pairs near the contact, which limit that step, usually separate along
+    /// the closest direction much more slowly than μ: the caller extends it as far as every pair
+    /// allows (see [`drift::Drift`]).
     fn settle(
         &self,
         t: f64,
-        d: f32,
+        [d, low]: [f32; 2],
         q: [Vec3; 2],
         frame: &Frame,
         ids: [&[u32]; 2],
@@ -269,7 +275,7 @@ impl Settle<'_, '_> {
         let h = 0.5 * self.tol;
         Settled::Step {
             h,
-            plain: (d - h) / self.mu,
+            plain: (low as f64 - h) / self.mu,
         }
     }
 }
@@ -331,9 +337,10 @@ trait Candidates {
     /// Places the second tooth's candidates at time `t` (`frame`).
     fn place(&mut self, t: f64, frame: &Frame);
     /// The least distance between the candidates now (the search may instead stop at the first
-    /// pair found within `enough`), measured first along `axis`: the gap and its closest points
-    /// (first tooth's frame); `None` when there are no candidates.
-    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, Vec3, Vec3)>;
+    /// pair found within `enough`), measured first along `axis`: the gap of the nearest pair
+    /// found, a lower bound of every candidate pair's distance (at most that gap), and the pair's
+    /// closest points (first tooth's frame); `None` when there are no candidates.
+    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, f32, Vec3, Vec3)>;
     /// How long the pair [`Self::least`] found stays apart along the drift's direction.
     fn nearest_drift(&mut self, drift: &drift::Drift) -> f64;
     /// The longest step, from `plain` (every pair allows it) up to `first`, that every candidate
@@ -369,12 +376,12 @@ fn advance_over(
         // within the tolerance is a contact to report. At the start they may already
         // interpenetrate, which only the least distance (0) shows.
         let enough = if t > 0.0 { ctx.tol as f32 } else { -1.0 };
-        let (d, qa, qb) = search.least(axis, enough)?;
+        let (d, low, qa, qb) = search.least(axis, enough)?;
         axis = (qb - qa).normalize_or(axis);
         // Touching: the depth is searched from the candidates that meet.
         let touching = if d == 0.0 { search.touching() } else { None };
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
-        let (h, plain) = match ctx.settle(t, d, [qa, qb], &frame, ids, round == MAX_STEPS) {
+        let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(c) => return Some(c),
             Settled::Stuck => return None,
             Settled::Step { h, plain } => (h, plain),

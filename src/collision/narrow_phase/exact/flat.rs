@@ -248,7 +248,7 @@ impl Candidates for Flat<'_> {
             .extend(self.ids_b.iter().map(|&y| place(mb, y, Some(&rel))));
     }
 
-    fn least(&mut self, axis: Vec3, _enough: f32) -> Option<(f32, Vec3, Vec3)> {
+    fn least(&mut self, axis: Vec3, _enough: f32) -> Option<(f32, f32, Vec3, Vec3)> {
         let (t, mu) = (self.t, self.mu);
         let (tris_a, tris_b) = (&self.tris_a, &self.tris_b);
         let mut best = (f32::INFINITY, Vec3::ZERO, Vec3::ZERO);
@@ -305,7 +305,7 @@ impl Candidates for Flat<'_> {
         }
         self.nearest = best_k;
         let (d, qa, qb) = best;
-        d.is_finite().then_some((d, qa, qb))
+        d.is_finite().then_some((d, d, qa, qb))
     }
 
     fn nearest_drift(&mut self, drift: &Drift) -> f64 {

@@ -79,10 +79,13 @@ impl Candidates for Search<'_, '_> {
         self.framed[1] = None;
     }
 
-    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, Vec3, Vec3)> {
+    fn least(&mut self, axis: Vec3, enough: f32) -> Option<(f32, f32, Vec3, Vec3)> {
         let (d, qa, qb, pair) = self.nearest(self.last, axis, enough);
         self.last = Some(pair);
-        d.is_finite().then_some((d, qa, qb))
+        // No pair left unmeasured is nearer than the pruning limit (less the rounding of
+        // squaring it and of the square roots compared with it).
+        let low = (d * (1.0 - NEAREST_SLACK)) * (1.0 - 1e-6);
+        d.is_finite().then_some((d, low, qa, qb))
     }
 
     fn nearest_drift(&mut self, drift: &Drift) -> f64 {
@@ -242,6 +245,11 @@ impl Search<'_, '_> {
     /// which starts at the distance of `first` (the previous step's nearest pair): the distance,
     /// its points and pair. The search ends early at the first pair found within `enough` (that
     /// pair is returned).
+    ///
+    /// Pruning is at [`NEAREST_SLACK`] below the best so far: what is left unmeasured is at least
+    /// that far, which is all a step needs, and the search does not spend most of its node
+    /// pairs proving that nothing is a little nearer. So the distance returned is the least
+    /// within that fraction (exact when it is 0: a pair that meets has no gap to prune at).
     fn nearest(
         &mut self,
         first: Option<(u32, u32)>,
@@ -264,26 +272,31 @@ impl Search<'_, '_> {
         let mut stack = std::mem::take(&mut self.s.stack);
         stack.clear();
         stack.push((0.0, 0, 0));
+        let limit = |best: f32| {
+            let l = best * (1.0 - NEAREST_SLACK);
+            l * l
+        };
         while let Some((lb2, na, nb)) = stack.pop() {
-            if lb2 >= best.0 * best.0 {
+            if lb2 >= limit(best.0) {
                 continue;
             }
             let (x, y) = self.nodes(na, nb);
             if x.leaf && y.leaf {
-                let cut = std::cell::Cell::new(best.0 * best.0);
+                let cut = std::cell::Cell::new(limit(best.0));
                 let finished = self.leaf_pairs(
                     na,
                     nb,
                     |p, q| p.distance_squared(q) < cut.get(),
                     |s, i, j| {
                         let (tx, ty) = (s.tri_a(i), s.tri_b(j));
-                        if tx.gap_to(&ty, tx.centre.distance(ty.centre)) >= best.0 {
+                        let lim = best.0 * (1.0 - NEAREST_SLACK);
+                        if tx.gap_to(&ty, tx.centre.distance(ty.centre)) >= lim {
                             return true;
                         }
                         let p = closest_points_facing_triangles(&tx.v, &ty.v);
                         if p.distance < best.0 {
                             best = (p.distance, p.on_first, p.on_second, (i, j));
-                            cut.set(best.0 * best.0);
+                            cut.set(limit(best.0));
                         }
                         best.0 > enough
                     },
@@ -300,7 +313,7 @@ impl Search<'_, '_> {
             }
             // The nearest pair is searched first (pushed last).
             kids[..n].sort_unstable_by(|p, q| q.0.total_cmp(&p.0));
-            stack.extend(kids[..n].iter().filter(|k| k.0 < best.0 * best.0));
+            stack.extend(kids[..n].iter().filter(|k| k.0 < limit(best.0)));
         }
         self.s.stack = stack;
         best
@@ -363,6 +376,11 @@ impl Search<'_, '_> {
         step.get()
     }
 }
+
+/// The fraction below the best distance so far at which [`Search::nearest`] prunes (its result
+/// is the least distance within it). At most a quarter, so that a search finding no pair within
+/// the tolerance leaves a lower bound above half of it (see `Settle::settle`).
+pub(super) const NEAREST_SLACK: f32 = 0.02;
 
 /// Distance (mm) within which two candidates count as meeting for [`Search::meeting`]: far
 /// above the rounding of the boxes and of the planes (f64), so no meeting pair is missed (more
@@ -528,6 +546,47 @@ pub(super) fn candidates(a: &Body, b: &Body, swept: &continuous::SweptContact) -
     SCRATCH.with_borrow_mut(|s| {
         list_candidates(a, b, swept, t, s);
         [s.pa.ids.clone(), s.pb.ids.clone()]
+    })
+}
+
+/// At the earliest leaf time of `swept`, the first step's search over the listed candidates:
+/// its gap and lower bound ([`Candidates::least`]), and the least distance of every candidate
+/// pair in a meeting leaf pair, measured one by one.
+#[cfg(test)]
+pub(super) fn least_at_start(
+    a: &Body,
+    b: &Body,
+    swept: &continuous::SweptContact,
+) -> Option<(f32, f32, f32)> {
+    let t = swept.earliest();
+    SCRATCH.with_borrow_mut(|s| {
+        list_candidates(a, b, swept, t, s);
+        let (ids_a, ids_b) = (std::mem::take(&mut s.pa.ids), std::mem::take(&mut s.pb.ids));
+        s.placed_a.begin(ids_a.len());
+        let frame = relative(&a.motion, &b.motion, t);
+        let mut search = Search {
+            ma: &a.shape.geometry.mesh,
+            mb: &b.shape.geometry.mesh,
+            ids: [&ids_a, &ids_b],
+            s,
+            rel: frame.rel,
+            frame: Mat3::IDENTITY,
+            framed: [None; 2],
+            last: None,
+        };
+        search.place(t, &frame);
+        let (d, low, _, _) = search.least(Vec3::X, -1.0)?;
+        let mut least = f32::INFINITY;
+        for x in 0..ids_a.len() as u32 {
+            for y in 0..ids_b.len() as u32 {
+                if search.meet(x, y) {
+                    let (tx, ty) = (search.tri_a(x), search.tri_b(y));
+                    least = least.min(closest_points_facing_triangles(&tx.v, &ty.v).distance);
+                }
+            }
+        }
+        (s.pa.ids, s.pb.ids) = (ids_a, ids_b);
+        Some((d, low, least))
     })
 }
 
