@@ -101,28 +101,10 @@ fn directional_steps_keep_half_the_tolerance() {
 /// (as near contact), and some on long ones.
 #[test]
 fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
-    use crate::collision::{CollisionShape, sampling::random_motion};
+    use crate::collision::sampling::random_motion;
     use crate::geometry::crossing_triangles;
-    use crate::sphere_tree::{TreeMethod, TreeSettings};
-    use crate::teeth::{Case, Dentition, Fdi};
-    use std::sync::Arc;
 
-    let mut case = Case::resolve("normal").unwrap();
-    case.case.resolution = Some(10_100);
-    let d = Dentition::build(case).unwrap();
-    let settings = TreeSettings {
-        method: TreeMethod::Medial,
-        branching: 8,
-        depth: 4,
-    };
-    let tooth = |n: i64| {
-        let t = (d.teeth.iter())
-            .find(|t| t.fdi == Fdi::new(n).unwrap())
-            .unwrap();
-        let tree = settings.build(&t.geometry.mesh, &t.geometry.bvh).unwrap();
-        (CollisionShape::new(Arc::clone(&t.geometry), &tree), t.pose)
-    };
-    let (a, b) = (tooth(16), tooth(15));
+    let [a, b] = first_molar_and_premolar();
     let mut rng = Rng(0x11_57ed);
     let (mut crossing, mut listed, mut in_leaves, mut contacts) = (0, [0; 2], [0; 2], 0);
     for case in 0..60 {
@@ -133,16 +115,7 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
         } else {
             random_motion(&mut rng, &b.1, a.1.translation)
         };
-        let body_a = Body {
-            shape: &a.0,
-            circle: crate::collision::Circle::of(&a.0.geometry, &a.1),
-            motion: ma,
-        };
-        let body_b = Body {
-            shape: &b.0,
-            circle: crate::collision::Circle::of(&b.0.geometry, &b.1),
-            motion: mb,
-        };
+        let (body_a, body_b) = (body(&a, ma), body(&b, mb));
         let Some(swept) = continuous::query(&body_a, &body_b, true) else {
             continue;
         };
@@ -201,41 +174,14 @@ fn listed_candidates_hold_every_triangle_that_meets_the_other_tooth() {
 /// some touching or overlapping), against every candidate pair measured one by one.
 #[test]
 fn hierarchical_search_bounds_the_least_distance() {
-    use crate::collision::{CollisionShape, sampling::random_motion};
-    use crate::sphere_tree::{TreeMethod, TreeSettings};
-    use crate::teeth::{Case, Dentition, Fdi};
-    use std::sync::Arc;
+    use crate::collision::sampling::random_motion;
 
-    let mut case = Case::resolve("normal").unwrap();
-    case.case.resolution = Some(10_100);
-    let d = Dentition::build(case).unwrap();
-    let settings = TreeSettings {
-        method: TreeMethod::Medial,
-        branching: 8,
-        depth: 4,
-    };
-    let tooth = |n: i64| {
-        let t = (d.teeth.iter())
-            .find(|t| t.fdi == Fdi::new(n).unwrap())
-            .unwrap();
-        let tree = settings.build(&t.geometry.mesh, &t.geometry.bvh).unwrap();
-        (CollisionShape::new(Arc::clone(&t.geometry), &tree), t.pose)
-    };
-    let (a, b) = (tooth(16), tooth(15));
-    let mut rng = Rng(0x5eed_11);
+    let [a, b] = first_molar_and_premolar();
+    let mut rng = Rng(0x005e_ed11);
     let (mut searched, mut apart, mut above) = (0, 0, 0);
     for case in 0..80 {
         let ma = random_motion(&mut rng, &a.1, b.1.translation);
-        let body_a = Body {
-            shape: &a.0,
-            circle: crate::collision::Circle::of(&a.0.geometry, &a.1),
-            motion: ma,
-        };
-        let body_b = Body {
-            shape: &b.0,
-            circle: crate::collision::Circle::of(&b.0.geometry, &b.1),
-            motion: Motion::still(b.1),
-        };
+        let (body_a, body_b) = (body(&a, ma), body(&b, Motion::still(b.1)));
         let Some(swept) = continuous::query(&body_a, &body_b, true) else {
             continue;
         };
@@ -266,4 +212,38 @@ fn hierarchical_search_bounds_the_least_distance() {
         searched > 30 && apart > 10,
         "{searched} searches, {apart} apart"
     );
+}
+
+/// Teeth 16 and 15 of the normal case at scan resolution (10,100 vertices), with medial sphere
+/// trees (branching 8, depth 4), and their poses.
+fn first_molar_and_premolar() -> [(crate::collision::CollisionShape, Pose); 2] {
+    use crate::collision::CollisionShape;
+    use crate::sphere_tree::{TreeMethod, TreeSettings};
+    use crate::teeth::{Case, Dentition, Fdi};
+    use std::sync::Arc;
+
+    let mut case = Case::resolve("normal").unwrap();
+    case.case.resolution = Some(10_100);
+    let d = Dentition::build(case).unwrap();
+    let settings = TreeSettings {
+        method: TreeMethod::Medial,
+        branching: 8,
+        depth: 4,
+    };
+    [16, 15].map(|n| {
+        let t = (d.teeth.iter())
+            .find(|t| t.fdi == Fdi::new(n).unwrap())
+            .unwrap();
+        let tree = settings.build(&t.geometry.mesh, &t.geometry.bvh).unwrap();
+        (CollisionShape::new(Arc::clone(&t.geometry), &tree), t.pose)
+    })
+}
+
+/// A tooth of [`first_molar_and_premolar`] moving by `motion` (its circle at its pose).
+fn body(tooth: &(crate::collision::CollisionShape, Pose), motion: Motion) -> Body<'_> {
+    Body {
+        shape: &tooth.0,
+        circle: crate::collision::Circle::of(&tooth.0.geometry, &tooth.1),
+        motion,
+    }
 }
