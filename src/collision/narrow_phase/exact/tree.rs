@@ -272,31 +272,29 @@ impl Search<'_, '_> {
         let mut stack = std::mem::take(&mut self.s.stack);
         stack.clear();
         stack.push((0.0, 0, 0));
-        let limit = |best: f32| {
-            let l = best * (1.0 - NEAREST_SLACK);
-            l * l
-        };
+        // The pruning limit below the best so far, and its square (box distances are squared).
+        let limit = |best: f32| best * (1.0 - NEAREST_SLACK);
+        let limit2 = |best: f32| limit(best) * limit(best);
         while let Some((lb2, na, nb)) = stack.pop() {
-            if lb2 >= limit(best.0) {
+            if lb2 >= limit2(best.0) {
                 continue;
             }
             let (x, y) = self.nodes(na, nb);
             if x.leaf && y.leaf {
-                let cut = std::cell::Cell::new(limit(best.0));
+                let cut = std::cell::Cell::new(limit2(best.0));
                 let finished = self.leaf_pairs(
                     na,
                     nb,
                     |p, q| p.distance_squared(q) < cut.get(),
                     |s, i, j| {
                         let (tx, ty) = (s.tri_a(i), s.tri_b(j));
-                        let lim = best.0 * (1.0 - NEAREST_SLACK);
-                        if tx.gap_to(&ty, tx.centre.distance(ty.centre)) >= lim {
+                        if tx.gap_to(&ty, tx.centre.distance(ty.centre)) >= limit(best.0) {
                             return true;
                         }
                         let p = closest_points_facing_triangles(&tx.v, &ty.v);
                         if p.distance < best.0 {
                             best = (p.distance, p.on_first, p.on_second, (i, j));
-                            cut.set(limit(best.0));
+                            cut.set(limit2(best.0));
                         }
                         best.0 > enough
                     },
@@ -313,7 +311,7 @@ impl Search<'_, '_> {
             }
             // The nearest pair is searched first (pushed last).
             kids[..n].sort_unstable_by(|p, q| q.0.total_cmp(&p.0));
-            stack.extend(kids[..n].iter().filter(|k| k.0 < limit(best.0)));
+            stack.extend(kids[..n].iter().filter(|k| k.0 < limit2(best.0)));
         }
         self.s.stack = stack;
         best
