@@ -8,7 +8,7 @@
 //! | circles | the circle centres get closer over the step (by more than [`APPROACH_MM`]) | never |
 //! | spheres | some overlapping leaf pair's centres get closer over the step (by more than [`APPROACH_MM`]) | the deepest leaf-sphere overlap at the end exceeds the deepest at the start by more than [`DEEPEN_MM`] |
 //! | continuous | some overlapping leaf pair's centres approach at time t of the step (half the rate of change of their squared distance, in f64, below −[`APPROACH_MM2`]) | as for spheres, with the end's overlapping leaves found afresh |
-//! | exact | the contact points' relative velocity along the normal, at time t, is below −[`APPROACH_MM`] per step | the meshes overlap at the end more deeply than the contact's depth by more than [`DEEPEN_MM`] |
+//! | exact | the contact points' relative velocity along the normal, at time t, is below −[`APPROACH_MM`] per step | the meshes overlap at the end more deeply than the contact's depth by more than [`DEEPEN_MM`] (the overlap the query found on the way when the contact carries it for these end poses, else searched here) |
 //!
 //! [`closes_in`] combines them for a contact that touches at the start of the step (for the
 //! discrete methods: at its end): whether it should stop its teeth.
@@ -122,14 +122,18 @@ fn end_gap(a: &Body, b: &Body) -> f32 {
 
 /// For a contact already touching at the start of the step: whether the overlap is deeper at the
 /// end of the step than at its start (exact: the meshes overlap at the end more than the
-/// contact's depth; continuous and spheres: the deepest overlap of leaf spheres grows, or
+/// contact's depth, taken from [`PairContact::end_overlap`] when it was found for these end
+/// poses; continuous and spheres: the deepest overlap of leaf spheres grows, or
 /// appears; circles: never). This catches what the contact points' velocities miss under
 /// rotation: other parts of the surfaces closing in.
 pub fn deepens(method: Method, a: &Body, b: &Body, contact: &PairContact) -> bool {
     let (ma, mb) = (&a.motion, &b.motion);
     match method {
         Method::Exact => {
-            let end = end_gap(a, b);
+            let end = match &contact.end_overlap {
+                Some(e) if e.poses == [ma.end, mb.end] => -e.depth_mm,
+                _ => end_gap(a, b),
+            };
             end < 0.0 && end < -contact.depth_mm - DEEPEN_MM
         }
         Method::Continuous | Method::Spheres => {

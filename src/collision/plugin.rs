@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::{
     broad_phase::{BroadItem, candidate_pairs},
     motion::Motion,
-    narrow_phase::{Body, Method, query},
+    narrow_phase::{Body, EndOverlap, Method, query},
     shape::{Circle, CollisionShape},
 };
 use crate::{
@@ -82,6 +82,9 @@ pub struct Contact {
     pub depth_mm: f32,
     /// Overlapping leaf pairs (compact-tree nodes of `a` and `b`).
     pub leaf_pairs: Vec<(u32, u32)>,
+    /// The meshes' overlap at the end of the step, when the method found it
+    /// ([`crate::collision::PairContact::end_overlap`]).
+    pub end_overlap: Option<EndOverlap>,
 }
 
 /// The contacts found in the last step that ran collision detection.
@@ -277,6 +280,7 @@ fn narrow_phase(
             normal: hit.normal,
             depth_mm: hit.depth_mm,
             leaf_pairs: hit.leaf_pairs,
+            end_overlap: hit.end_overlap,
         };
         if !touching.0.contains(&(ea, eb)) {
             commands.trigger(ContactStarted {

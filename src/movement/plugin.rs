@@ -459,6 +459,7 @@ fn resolve(
                 normal: c.normal,
                 depth_mm: c.depth_mm,
                 leaf_pairs: c.leaf_pairs.clone(),
+                end_overlap: c.end_overlap,
             };
             let (a, b) = if i < j {
                 (i, j)
@@ -466,6 +467,9 @@ fn resolve(
                 contact.points.swap(0, 1);
                 contact.normal = -contact.normal;
                 contact.leaf_pairs.iter_mut().for_each(|p| *p = (p.1, p.0));
+                if let Some(e) = &mut contact.end_overlap {
+                    e.poses.swap(0, 1);
+                }
                 (j, i)
             };
             found.push(Found { a, b, contact });

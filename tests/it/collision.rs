@@ -430,6 +430,7 @@ fn exact_deepening_is_judged_from_where_the_meshes_meet() {
             normal: towards,
             depth_mm,
             leaf_pairs: Vec::new(),
+            end_overlap: None,
         };
         let expected = end_gap < 0.0 && end_gap < -depth_mm - 1e-6;
         fn body(t: &TestTooth, m: Motion) -> Body<'_> {

@@ -26,5 +26,6 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
         normal: Vec3::new(dir.x, 0.0, dir.y),
         depth_mm: r - d,
         leaf_pairs: Vec::new(),
+        end_overlap: None,
     })
 }

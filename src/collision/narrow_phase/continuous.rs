@@ -388,6 +388,7 @@ pub fn query(a: &Body, b: &Body, all_pairs: bool) -> Option<SweptContact> {
             normal: n.as_vec3(),
             depth_mm: (ra + rb - ca.distance(cb)) as f32,
             leaf_pairs: leaf_times.iter().map(|&(i, j, _)| (i, j)).collect(),
+            end_overlap: None,
         },
         leaf_times,
     })

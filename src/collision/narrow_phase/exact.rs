@@ -48,7 +48,12 @@
 //! meshes ([`mesh_penetration_near`]: the candidate triangles hold every triangle that crosses
 //! the other surface, so the search walks from them over the part of each surface inside the
 //! other instead of testing every vertex; the hierarchical search first narrows them to those
-//! near a candidate of the other tooth, which still holds every crossing one). After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
+//! near a candidate of the other tooth, which still holds every crossing one). A contact at the
+//! start of the motion also carries the meshes' overlap at its end ([`PairContact::end_overlap`],
+//! hierarchical search only), which a response needs to tell whether the contact deepens: every
+//! triangle pair that meets at the end touches during the motion, so it is a candidate pair, and
+//! the walk goes from the candidates that meet at the end placement instead of the whole meshes'
+//! meeting triangles, which cost a search of both meshes' hierarchies. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
 //! conservative, time is reported with its gap.
 //!
 //! Two ways to search the candidates, the same pairs and the same guarantees. **Flat**
@@ -80,7 +85,7 @@
 use glam::Vec3;
 
 use super::lanes::Affine32;
-use super::{Body, PairContact, continuous};
+use super::{Body, EndOverlap, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion};
 use crate::geometry::{FacePlane, NearContact, mesh_penetration_near};
 
@@ -195,6 +200,10 @@ pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
             && let Some(mut c) = advance(&sa, &sb, &swept, tol)
         {
             c.time_of_contact = (t + c.time_of_contact as f64 * (end - t)) as f32;
+            if end < 1.0 {
+                // Found at the window's end, not the motion's.
+                c.end_overlap = None;
+            }
             return Some(c);
         }
         if end >= 1.0 {
@@ -301,6 +310,7 @@ fn report(
         normal: (qb - qa).try_normalize().unwrap_or(swept.contact.normal),
         depth_mm: -(d as f32),
         leaf_pairs: swept.contact.leaf_pairs.clone(),
+        end_overlap: None,
     };
     if d == 0.0 {
         // Touching or interpenetrating (only possible at the start): the candidates already
@@ -353,6 +363,13 @@ trait Candidates {
     fn touching(&mut self) -> Option<[Vec<u32>; 2]> {
         None
     }
+    /// With the second tooth placed by `frame`: a part of each tooth's candidates that holds
+    /// every candidate meeting the other's candidates there, as [`Self::touching`] does at the
+    /// current placement; `None` when the search does not list them (the caller then leaves
+    /// the question to whoever asks it).
+    fn meeting_at(&mut self, _frame: &Frame) -> Option<[Vec<u32>; 2]> {
+        None
+    }
 }
 
 /// The advancement loop from time `t`, the first search along `axis`: search, stop or step
@@ -382,7 +399,12 @@ fn advance_over(
         let touching = if d == 0.0 { search.touching() } else { None };
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
         let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
-            Settled::Report(c) => return Some(c),
+            Settled::Report(mut c) => {
+                if t == 0.0 {
+                    c.end_overlap = end_overlap(a, b, search);
+                }
+                return Some(c);
+            }
             Settled::Stuck => return None,
             Settled::Step { h, plain } => (h, plain),
         };
@@ -401,6 +423,33 @@ fn advance_over(
     None
 }
 
+/// For a contact at the start of the motion: the meshes' overlap at its end, walked
+/// ([`mesh_penetration_near`]) from the candidates that meet there. That holds every triangle
+/// that meets the other mesh at the end: a triangle pair meeting then touches during the motion,
+/// so it is a candidate pair (see the module doc). So the depth is the one the walk finds from
+/// the whole meshes' meeting triangles, without searching the whole meshes for them. `None` when
+/// the search does not list the meeting candidates (flat).
+fn end_overlap(a: &Body, b: &Body, search: &mut impl Candidates) -> Option<EndOverlap> {
+    let poses = [a.motion.end, b.motion.end];
+    let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
+    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+    let (depth_mm, _, _) = mesh_penetration_near(
+        NearContact {
+            mesh: ga.mesh_ref(),
+            stars: &ga.stars,
+            near: &near_a,
+        },
+        &poses[0],
+        NearContact {
+            mesh: gb.mesh_ref(),
+            stars: &gb.stars,
+            near: &near_b,
+        },
+        &poses[1],
+    );
+    Some(EndOverlap { poses, depth_mm })
+}
+
 /// Both teeth at one time, seen from the first tooth.
 struct Frame {
     pose_a: crate::geometry::Pose,
@@ -413,7 +462,11 @@ struct Frame {
 
 /// Both teeth at time `t`.
 fn relative(a: &Motion, b: &Motion, t: f64) -> Frame {
-    let (pose_a, pose_b) = (a.at(t as f32), b.at(t as f32));
+    frame_at(a.at(t as f32), b.at(t as f32))
+}
+
+/// Both teeth at the given poses.
+fn frame_at(pose_a: crate::geometry::Pose, pose_b: crate::geometry::Pose) -> Frame {
     let (da, db) = (DPose::from_pose(&pose_a), DPose::from_pose(&pose_b));
     let to_a = da.rotation.inverse();
     let rel = Affine32::new(to_a * db.rotation, to_a * (db.translation - da.translation));

@@ -95,6 +95,22 @@ pub struct PairContact {
     pub depth_mm: f32,
     /// Overlapping leaf pairs (compact-tree node indices) at the reported time.
     pub leaf_pairs: Vec<(u32, u32)>,
+    /// For a contact at the start of the motion, the meshes' overlap at its end when the method
+    /// found it on the way (exact, at scan resolution): what a response needs to tell whether the
+    /// contact deepens ([`crate::collision::closing::deepens`]), which otherwise searches the
+    /// whole meshes for it.
+    pub end_overlap: Option<EndOverlap>,
+}
+
+/// The overlap of two teeth's meshes at the end of their motion, found by the exact query for a
+/// contact at its start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndOverlap {
+    /// The end poses it was found at: first tooth, second. It holds for these poses only.
+    pub poses: [crate::geometry::Pose; 2],
+    /// The penetration depth there (mm, the estimate of
+    /// [`crate::geometry::mesh_penetration_near`]); 0 or less when the meshes do not overlap.
+    pub depth_mm: f32,
 }
 
 /// Runs `method` on a pair of teeth moving over one step: the first contact (or, for the discrete

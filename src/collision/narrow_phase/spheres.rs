@@ -280,5 +280,6 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
         normal: n.as_vec3(),
         depth_mm: depth as f32,
         leaf_pairs: pairs,
+        end_overlap: None,
     })
 }

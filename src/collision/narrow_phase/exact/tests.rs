@@ -214,6 +214,79 @@ fn hierarchical_search_bounds_the_least_distance() {
     );
 }
 
+/// A contact at the start of a short step carries the meshes' overlap at the step's end, walked
+/// from the candidates that meet there: the same depth as the whole-mesh search finds, so
+/// `deepens` answers the same with it as without it (when it searches the whole meshes' meeting
+/// triangles). Checked at scan resolution on seeded steps of two neighbouring teeth that start
+/// overlapping by up to 0.4 mm and move up to 0.3 mm and 1° (in half of them both teeth move):
+/// some end apart, some deeper, some shallower.
+#[test]
+fn end_overlap_is_the_whole_meshes_overlap() {
+    use crate::collision::{Method, closing::deepens};
+    use crate::geometry::mesh_penetration;
+
+    let [a, b] = first_molar_and_premolar();
+    let towards = (b.1.translation - a.1.translation).normalize();
+    let mut rng = Rng(0x0e0d_0f57);
+    let (mut carried, mut apart, mut deeper) = (0, 0, 0);
+    for case in 0..40 {
+        let start = Pose::new(
+            a.1.rotation,
+            a.1.translation + towards * 0.4 * rng.uniform(),
+        );
+        let turn = Quat::from_axis_angle(rng.unit(), rng.uniform().to_radians());
+        let end = Pose::new(
+            (turn * start.rotation).normalize(),
+            start.translation + rng.vec(0.3),
+        );
+        let ma = Motion { start, end };
+        let mb = if case % 2 == 0 {
+            Motion::still(b.1)
+        } else {
+            let shift = Pose::new(b.1.rotation, b.1.translation + rng.vec(0.1));
+            Motion {
+                start: b.1,
+                end: shift,
+            }
+        };
+        let (body_a, body_b) = (body(&a, ma), body(&b, mb));
+        let Some(c) = query(&body_a, &body_b) else {
+            continue;
+        };
+        let Some(e) = c.end_overlap else {
+            assert!(
+                c.time_of_contact > 0.0,
+                "case {case}: a contact at the start without its end"
+            );
+            continue;
+        };
+        carried += 1;
+        assert_eq!(c.time_of_contact, 0.0, "case {case}");
+        assert_eq!(e.poses, [ma.end, mb.end], "case {case}");
+        let whole = mesh_penetration(
+            a.0.geometry.mesh_ref(),
+            &ma.end,
+            b.0.geometry.mesh_ref(),
+            &mb.end,
+        );
+        assert_eq!(e.depth_mm, whole.0, "case {case}");
+        apart += (whole.0 <= 0.0) as usize;
+        let searched = PairContact {
+            end_overlap: None,
+            ..c.clone()
+        };
+        let deepening = deepens(Method::Exact, &body_a, &body_b, &c);
+        assert_eq!(
+            deepening,
+            deepens(Method::Exact, &body_a, &body_b, &searched),
+            "case {case}"
+        );
+        deeper += deepening as usize;
+    }
+    eprintln!("{carried} carried, {apart} end apart, {deeper} deepen");
+    assert!(carried > 25 && apart > 2 && deeper > 5 && carried - deeper > 5);
+}
+
 /// Teeth 16 and 15 of the normal case at scan resolution (10,100 vertices), with medial sphere
 /// trees (branching 8, depth 4), and their poses.
 fn first_molar_and_premolar() -> [(crate::collision::CollisionShape, Pose); 2] {

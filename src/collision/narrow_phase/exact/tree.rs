@@ -102,6 +102,13 @@ impl Candidates for Search<'_, '_> {
     fn touching(&mut self) -> Option<[Vec<u32>; 2]> {
         Some(self.meeting())
     }
+
+    fn meeting_at(&mut self, frame: &Frame) -> Option<[Vec<u32>; 2]> {
+        self.place(1.0, frame);
+        // The first patch keeps its framing; only the second is refitted to its new placement.
+        self.set_frame(self.framed[0].unwrap_or(Vec3::Z));
+        Some(self.meeting())
+    }
 }
 
 impl Search<'_, '_> {
