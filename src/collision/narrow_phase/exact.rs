@@ -50,7 +50,7 @@
 //! other instead of testing every vertex; the hierarchical search first narrows them to those
 //! near a candidate of the other tooth, which still holds every crossing one). A contact at the
 //! start of the motion also carries the meshes' overlap at its end ([`PairContact::end_overlap`],
-//! hierarchical search only), which a response needs to tell whether the contact deepens: every
+//! both searches), which a response needs to tell whether the contact deepens: every
 //! triangle pair that meets at the end touches during the motion, so it is a candidate pair, and
 //! the walk goes from the candidates that meet at the end placement instead of the whole meshes'
 //! meeting triangles, which cost a search of both meshes' hierarchies. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
@@ -96,6 +96,10 @@ pub const GAP_TOLERANCE_MM: f32 = 0.01;
 const WHOLE_STEP_TRAVEL_MM: f64 = 1.0;
 /// Most advancement steps per query.
 pub const MAX_STEPS: u32 = 1000;
+/// Distance (mm) within which two candidates count as meeting, when the searches list those
+/// that meet ([`Candidates::touching`], [`Candidates::meeting_at`]): far above the rounding of
+/// the boxes, spheres and planes (f64), so no meeting pair is missed (more are allowed).
+const MEETING_MM: f32 = 1e-4;
 
 /// One candidate triangle placed at the current time: vertices, bounding sphere and plane.
 #[derive(Clone, Copy, Default)]
@@ -160,6 +164,18 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
 
 /// The exact query leaving a gap of at most `tolerance` (mm, positive) at the reported contact.
 pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
+    query_at(a, b, tolerance, None)
+}
+
+/// [`query`] for teeth whose overlap at the start poses may already be `known`: the overlap a
+/// contact carried from the end of the step before ([`PairContact::end_overlap`]), used when its
+/// poses are the start poses (the same depth and points the search would find, without walking
+/// the meshes again); otherwise ignored.
+pub fn query_knowing(a: &Body, b: &Body, known: Option<&EndOverlap>) -> Option<PairContact> {
+    query_at(a, b, GAP_TOLERANCE_MM, known)
+}
+
+fn query_at(a: &Body, b: &Body, tolerance: f32, known: Option<&EndOverlap>) -> Option<PairContact> {
     let tol = tolerance.max(1e-6) as f64;
     // The earliest leaf time bounds the first contact from below; from there the step is searched
     // in windows of growing length, each with only the leaf pairs that meet within it (a slerp and
@@ -170,7 +186,7 @@ pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
         a.motion.speed_bound(a.shape.max_rho as f64) + b.motion.speed_bound(b.shape.max_rho as f64);
     if whole <= WHOLE_STEP_TRAVEL_MM {
         let swept = continuous::query(a, b, true)?;
-        return advance(a, b, &swept, tol);
+        return advance(a, b, &swept, tol, known);
     }
     let first = continuous::query(a, b, false)?;
     let mut t = first.earliest();
@@ -197,7 +213,7 @@ pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
             },
         );
         if let Some(swept) = continuous::query(&sa, &sb, true)
-            && let Some(mut c) = advance(&sa, &sb, &swept, tol)
+            && let Some(mut c) = advance(&sa, &sb, &swept, tol, known)
         {
             c.time_of_contact = (t + c.time_of_contact as f64 * (end - t)) as f32;
             if end < 1.0 {
@@ -221,7 +237,13 @@ const FLAT_PAIRS: usize = 4096;
 /// Conservative advancement over the bodies' whole motion, from the earliest meeting leaf time of
 /// `swept` (which must list every meeting leaf pair): flat for few candidates, hierarchical for
 /// many.
-fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact, tol: f64) -> Option<PairContact> {
+fn advance(
+    a: &Body,
+    b: &Body,
+    swept: &continuous::SweptContact,
+    tol: f64,
+    known: Option<&EndOverlap>,
+) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let pairs: usize = swept
         .leaf_times
@@ -229,9 +251,9 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact, tol: f64) -> Op
         .map(|&(i, j, _)| ta.triangles(i as usize).len() * tb.triangles(j as usize).len())
         .sum();
     if pairs <= FLAT_PAIRS {
-        flat::advance(a, b, swept, tol)
+        flat::advance(a, b, swept, tol, known)
     } else {
-        tree::advance(a, b, swept, tol)
+        tree::advance(a, b, swept, tol, known)
     }
 }
 
@@ -252,6 +274,8 @@ struct Settle<'x, 'y> {
     swept: &'x continuous::SweptContact,
     tol: f64,
     mu: f64,
+    /// The overlap already known at some poses (see [`query_knowing`]).
+    known: Option<&'x EndOverlap>,
 }
 
 impl Settle<'_, '_> {
@@ -275,7 +299,7 @@ impl Settle<'_, '_> {
         let q = q.map(|p| frame.pose_a.transform_point(p));
         let d = d as f64;
         if d <= self.tol || last {
-            let c = report(self.a, self.b, self.swept, t, d, q, frame, ids[0], ids[1]);
+            let c = report(self.a, self.b, self.swept, t, d, q, frame, ids, self.known);
             return Settled::Report(c);
         }
         if self.mu <= 0.0 {
@@ -300,8 +324,8 @@ fn report(
     d: f64,
     q: [Vec3; 2],
     frame: &Frame,
-    ids_a: &[u32],
-    ids_b: &[u32],
+    [ids_a, ids_b]: [&[u32]; 2],
+    known: Option<&EndOverlap>,
 ) -> PairContact {
     let [qa, qb] = q;
     let mut contact = PairContact {
@@ -314,22 +338,25 @@ fn report(
     };
     if d == 0.0 {
         // Touching or interpenetrating (only possible at the start): the candidates already
-        // touch, so only the depth is left to find.
+        // touch, so only the depth is left to find (or is known for these poses).
         let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-        let (depth, pa, pb) = mesh_penetration_near(
-            NearContact {
-                mesh: ga.mesh_ref(),
-                stars: &ga.stars,
-                near: ids_a,
-            },
-            &frame.pose_a,
-            NearContact {
-                mesh: gb.mesh_ref(),
-                stars: &gb.stars,
-                near: ids_b,
-            },
-            &frame.pose_b,
-        );
+        let (depth, pa, pb) = match known.filter(|k| k.poses == [frame.pose_a, frame.pose_b]) {
+            Some(k) => (k.depth_mm, k.points[0], k.points[1]),
+            None => mesh_penetration_near(
+                NearContact {
+                    mesh: ga.mesh_ref(),
+                    stars: &ga.stars,
+                    near: ids_a,
+                },
+                &frame.pose_a,
+                NearContact {
+                    mesh: gb.mesh_ref(),
+                    stars: &gb.stars,
+                    near: ids_b,
+                },
+                &frame.pose_b,
+            ),
+        };
         if depth > 0.0 {
             contact.depth_mm = depth;
             contact.points = [pa, pb];
@@ -428,12 +455,12 @@ fn advance_over(
 /// that meets the other mesh at the end: a triangle pair meeting then touches during the motion,
 /// so it is a candidate pair (see the module doc). So the depth is the one the walk finds from
 /// the whole meshes' meeting triangles, without searching the whole meshes for them. `None` when
-/// the search does not list the meeting candidates (flat).
+/// the search does not list the meeting candidates.
 fn end_overlap(a: &Body, b: &Body, search: &mut impl Candidates) -> Option<EndOverlap> {
     let poses = [a.motion.end, b.motion.end];
     let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    let (depth_mm, _, _) = mesh_penetration_near(
+    let (depth_mm, pa, pb) = mesh_penetration_near(
         NearContact {
             mesh: ga.mesh_ref(),
             stars: &ga.stars,
@@ -447,7 +474,11 @@ fn end_overlap(a: &Body, b: &Body, search: &mut impl Candidates) -> Option<EndOv
         },
         &poses[1],
     );
-    Some(EndOverlap { poses, depth_mm })
+    Some(EndOverlap {
+        poses,
+        depth_mm,
+        points: [pa, pb],
+    })
 }
 
 /// Both teeth at one time, seen from the first tooth.

@@ -111,6 +111,9 @@ pub struct EndOverlap {
     /// The penetration depth there (mm, the estimate of
     /// [`crate::geometry::mesh_penetration_near`]); 0 or less when the meshes do not overlap.
     pub depth_mm: f32,
+    /// The deepest point with the nearest point of the other surface (world): on the first
+    /// tooth's side, then on the second's, as [`PairContact::points`] of an overlap.
+    pub points: [Vec3; 2],
 }
 
 /// Runs `method` on a pair of teeth moving over one step: the first contact (or, for the discrete
@@ -146,6 +149,17 @@ pub struct EndOverlap {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn query(method: Method, a: &Body, b: &Body) -> Option<PairContact> {
+    query_knowing(method, a, b, None)
+}
+
+/// [`query`] for teeth whose overlap at the start poses may be `known` from the step before
+/// (the exact method uses it, see [`exact::query_knowing`]; the others ignore it).
+pub fn query_knowing(
+    method: Method,
+    a: &Body,
+    b: &Body,
+    known: Option<&EndOverlap>,
+) -> Option<PairContact> {
     if a.shape.tree.is_empty() || b.shape.tree.is_empty() {
         return None;
     }
@@ -153,6 +167,6 @@ pub fn query(method: Method, a: &Body, b: &Body) -> Option<PairContact> {
         Method::Circles => circles::query(a, b),
         Method::Spheres => spheres::query(a, b),
         Method::Continuous => continuous::query(a, b, false).map(|c| c.contact),
-        Method::Exact => exact::query(a, b),
+        Method::Exact => exact::query_knowing(a, b, known),
     }
 }

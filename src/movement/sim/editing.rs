@@ -156,6 +156,7 @@ impl Simulation {
             total_energy_lost_uj: 0.0,
             pdl: super::PdlState::default(),
             elapsed_days: 0.0,
+            known: BTreeMap::new(),
         };
         if settings.model == MovementModel::Pdl {
             for t in &mut sim.teeth {

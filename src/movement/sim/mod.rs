@@ -49,6 +49,7 @@
 
 use std::{
     collections::{BTreeMap, BTreeSet},
+    sync::Arc,
     time::Instant,
 };
 
@@ -71,9 +72,11 @@ use super::{
 };
 use crate::{
     collision::broad_phase::{BroadItem, candidate_pairs},
-    collision::{Body, Circle, CollisionShape, Method, Motion, PairContact, query},
+    collision::{
+        Body, Circle, CollisionShape, EndOverlap, Method, Motion, PairContact, query_knowing,
+    },
     geometry::{Pose, mesh_separation},
-    teeth::{Arch, Fdi, Load, WireModel, arch::ArchCurve},
+    teeth::{Arch, Fdi, Load, ToothGeometry, WireModel, arch::ArchCurve},
 };
 
 /// Rounds of cutting steps at contact times before blocked teeth are stopped outright.
@@ -250,6 +253,17 @@ pub struct Simulation {
     pub pdl: PdlState,
     /// Clinical (PDL) or simulated (paper) time elapsed (days).
     pub elapsed_days: f64,
+    /// The overlaps found at the end of the last step for its contacts that touched at their
+    /// start (exact method), by tooth pair: the next step's queries start from them.
+    known: BTreeMap<(usize, usize), KnownOverlap>,
+}
+
+/// An overlap at the end of a step ([`EndOverlap`]) with the geometries it was found for (kept
+/// alive, so a tooth given another mesh is never taken for the same one).
+#[derive(Clone, Debug)]
+struct KnownOverlap {
+    geometry: [Arc<ToothGeometry>; 2],
+    overlap: EndOverlap,
 }
 
 fn row(arch: Arch) -> usize {
@@ -310,18 +324,34 @@ impl Simulation {
         pairs
     }
 
-    /// The narrow phase on `pairs` with the current motions.
+    /// The narrow phase on `pairs` with the current motions, each pair starting from the
+    /// overlap its contact carried at the end of the last step (used only where its poses and
+    /// meshes are this step's start).
     pub fn narrow(&self, pairs: &[(usize, usize)]) -> Vec<Found> {
         pairs
             .iter()
             .filter_map(|&(a, b)| {
-                query(self.method, &self.body(a), &self.body(b)).map(|contact| Found {
-                    a,
-                    b,
-                    contact,
-                })
+                let (ta, tb) = (&self.teeth[a].shape.geometry, &self.teeth[b].shape.geometry);
+                let known = self
+                    .known
+                    .get(&(a, b))
+                    .filter(|k| Arc::ptr_eq(&k.geometry[0], ta) && Arc::ptr_eq(&k.geometry[1], tb));
+                let known = known.map(|k| &k.overlap);
+                query_knowing(self.method, &self.body(a), &self.body(b), known)
+                    .map(|contact| Found { a, b, contact })
             })
             .collect()
+    }
+
+    /// Keeps the overlaps the last step's contacts carried, for the next step's queries.
+    fn keep_overlaps(&mut self) {
+        self.known = (self.last.contacts.iter())
+            .filter_map(|f| {
+                let overlap = f.contact.end_overlap?;
+                let geometry = [f.a, f.b].map(|i| Arc::clone(&self.teeth[i].shape.geometry));
+                Some(((f.a, f.b), KnownOverlap { geometry, overlap }))
+            })
+            .collect();
     }
 
     /// One whole step: propose, detect, respond, commit.
@@ -334,6 +364,7 @@ impl Simulation {
         let found = self.narrow(&pairs);
         let tested = pairs.len();
         self.resolve(found);
+        self.keep_overlaps();
         self.last.pairs_tested = tested;
         self.last.queries += tested;
         self.last.collision_ns = t0.elapsed().as_nanos() as u64;

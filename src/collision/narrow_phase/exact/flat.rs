@@ -5,11 +5,11 @@
 use glam::Vec3;
 
 use super::drift::Drift;
-use super::{Candidates, Frame, PlacedTri, Settle, advance_over, relative};
+use super::{Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::Body;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::collision::narrow_phase::{PairContact, continuous};
+use crate::collision::narrow_phase::{EndOverlap, PairContact, continuous};
 use crate::geometry::closest_points_facing_triangles;
 
 /// Allowance (mm) for the f32 rounding of a stored triangle-pair distance and of the poses it was
@@ -54,9 +54,10 @@ pub(super) fn advance(
     b: &Body,
     swept: &continuous::SweptContact,
     tol: f64,
+    known: Option<&EndOverlap>,
 ) -> Option<PairContact> {
     SCRATCH.with_borrow_mut(|scratch| {
-        let contact = advance_with(a, b, swept, tol, scratch);
+        let contact = advance_with(a, b, swept, tol, known, scratch);
         // Lists of deep contacts between large meshes are not kept.
         if scratch.candidates.capacity() > KEEP_CANDIDATES {
             scratch.candidates = Vec::new();
@@ -73,6 +74,7 @@ fn advance_with(
     b: &Body,
     swept: &continuous::SweptContact,
     tol: f64,
+    known: Option<&EndOverlap>,
     scratch: &mut Scratch,
 ) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
@@ -201,10 +203,12 @@ fn advance_with(
         swept,
         tol,
         mu,
+        known,
     };
     let mut search = Flat {
         tris_a,
         tris_b: Vec::with_capacity(ids_b.len()),
+        ids_a: &ids_a,
         ids_b: &ids_b,
         mb,
         candidates,
@@ -229,6 +233,8 @@ struct Flat<'x> {
     /// The first tooth's candidate triangles as stored, the second's placed anew each step.
     tris_a: Vec<PlacedTri>,
     tris_b: Vec<PlacedTri>,
+    /// Their mesh triangle numbers.
+    ids_a: &'x [u32],
     ids_b: &'x [u32],
     mb: &'x crate::geometry::TriMesh,
     candidates: &'x mut Vec<Candidate>,
@@ -313,6 +319,30 @@ impl Candidates for Flat<'_> {
             let c = &self.candidates[k];
             drift.step(&self.tris_a[c.x as usize], &self.tris_b[c.y as usize])
         })
+    }
+
+    /// Every candidate in a candidate pair that two lower bounds of its distance (bounding
+    /// spheres, planes) do not put more than [`MEETING_MM`] apart at the placement: every pair
+    /// that meets there among them.
+    fn meeting_at(&mut self, frame: &Frame) -> Option<[Vec<u32>; 2]> {
+        self.place(1.0, frame);
+        let mut hit = [vec![false; self.ids_a.len()], vec![false; self.ids_b.len()]];
+        for c in self.candidates.iter() {
+            let (x, y) = (c.x as usize, c.y as usize);
+            let (tx, ty) = (&self.tris_a[x], &self.tris_b[y]);
+            let between = tx.centre.distance(ty.centre);
+            if between - tx.radius - ty.radius <= MEETING_MM && tx.gap_to(ty, between) <= MEETING_MM
+            {
+                hit[0][x] = true;
+                hit[1][y] = true;
+            }
+        }
+        let pick = |hit: &[bool], ids: &[u32]| -> Vec<u32> {
+            (hit.iter().zip(ids))
+                .filter_map(|(&h, &id)| h.then_some(id))
+                .collect()
+        };
+        Some([pick(&hit[0], self.ids_a), pick(&hit[1], self.ids_b)])
     }
 
     fn extend(&mut self, drift: &Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64 {

@@ -217,18 +217,26 @@ fn hierarchical_search_bounds_the_least_distance() {
 /// A contact at the start of a short step carries the meshes' overlap at the step's end, walked
 /// from the candidates that meet there: the same depth as the whole-mesh search finds, so
 /// `deepens` answers the same with it as without it (when it searches the whole meshes' meeting
-/// triangles). Checked at scan resolution on seeded steps of two neighbouring teeth that start
+/// triangles). Checked at the paper's resolution (flat search) and at scan resolution on seeded steps of two neighbouring teeth that start
 /// overlapping by up to 0.4 mm and move up to 0.3 mm and 1° (in half of them both teeth move):
-/// some end apart, some deeper, some shallower.
+/// some end apart, some deeper, some shallower. A query of the next step, starting where this
+/// one ended, gives the same contact when it is told that overlap, and uses it.
 #[test]
 fn end_overlap_is_the_whole_meshes_overlap() {
+    for vertices in [125, 10_100] {
+        end_overlap_at(vertices);
+    }
+}
+
+/// [`end_overlap_is_the_whole_meshes_overlap`] at `vertices` per tooth (125: the flat search).
+fn end_overlap_at(vertices: u32) {
     use crate::collision::{Method, closing::deepens};
     use crate::geometry::mesh_penetration;
 
-    let [a, b] = first_molar_and_premolar();
+    let [a, b] = molar_and_premolar_at(vertices);
     let towards = (b.1.translation - a.1.translation).normalize();
     let mut rng = Rng(0x0e0d_0f57);
-    let (mut carried, mut apart, mut deeper) = (0, 0, 0);
+    let (mut carried, mut apart, mut deeper, mut known) = (0, 0, 0, 0);
     for case in 0..40 {
         let start = Pose::new(
             a.1.rotation,
@@ -282,21 +290,62 @@ fn end_overlap_is_the_whole_meshes_overlap() {
             "case {case}"
         );
         deeper += deepening as usize;
+
+        // The next step starts where this one ended: knowing the overlap there changes nothing
+        // but the work; an overlap known at other poses is ignored, and one at these poses is
+        // what the contact reports.
+        let next = |m: &Motion, shift: Vec3| Motion {
+            start: m.end,
+            end: Pose::new(m.end.rotation, m.end.translation + shift),
+        };
+        let (na, nb) = (next(&ma, rng.vec(0.05)), next(&mb, Vec3::ZERO));
+        let (body_a, body_b) = (body(&a, na), body(&b, nb));
+        let plain = query(&body_a, &body_b);
+        assert_eq!(
+            query_knowing(&body_a, &body_b, Some(&e)),
+            plain,
+            "case {case}"
+        );
+        let elsewhere = EndOverlap {
+            poses: [ma.start, mb.start],
+            ..e
+        };
+        assert_eq!(
+            query_knowing(&body_a, &body_b, Some(&elsewhere)),
+            plain,
+            "case {case}"
+        );
+        if plain.as_ref().is_some_and(|c| c.depth_mm > 0.0) {
+            let doctored = EndOverlap {
+                depth_mm: e.depth_mm + 1.0,
+                ..e
+            };
+            let c = query_knowing(&body_a, &body_b, Some(&doctored)).unwrap();
+            assert_eq!(c.depth_mm, doctored.depth_mm, "case {case}");
+            known += 1;
+        }
     }
-    eprintln!("{carried} carried, {apart} end apart, {deeper} deepen");
-    assert!(carried > 25 && apart > 2 && deeper > 5 && carried - deeper > 5);
+    eprintln!(
+        "{vertices} vertices: {carried} carried, {apart} end apart, {deeper} deepen, {known} known"
+    );
+    assert!(carried > 25 && apart > 2 && deeper > 5 && carried - deeper > 5 && known > 10);
 }
 
 /// Teeth 16 and 15 of the normal case at scan resolution (10,100 vertices), with medial sphere
 /// trees (branching 8, depth 4), and their poses.
 fn first_molar_and_premolar() -> [(crate::collision::CollisionShape, Pose); 2] {
+    molar_and_premolar_at(10_100)
+}
+
+/// Teeth 16 and 15 of the normal case at `vertices` per tooth, as [`first_molar_and_premolar`].
+fn molar_and_premolar_at(vertices: u32) -> [(crate::collision::CollisionShape, Pose); 2] {
     use crate::collision::CollisionShape;
     use crate::sphere_tree::{TreeMethod, TreeSettings};
     use crate::teeth::{Case, Dentition, Fdi};
     use std::sync::Arc;
 
     let mut case = Case::resolve("normal").unwrap();
-    case.case.resolution = Some(10_100);
+    case.case.resolution = Some(vertices);
     let d = Dentition::build(case).unwrap();
     let settings = TreeSettings {
         method: TreeMethod::Medial,

@@ -6,11 +6,11 @@ use glam::{Mat3, Vec3};
 
 use super::drift::Drift;
 use super::patch::{Patch, PatchNode};
-use super::{Candidates, Frame, PlacedTri, Settle, advance_over, relative};
+use super::{Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
 use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::collision::narrow_phase::{Body, PairContact, continuous};
+use crate::collision::narrow_phase::{Body, EndOverlap, PairContact, continuous};
 use crate::geometry::{Aabb, Pose, Sphere, TriMesh, closest_points_facing_triangles};
 
 /// Per-thread scratch of the advancement, reused between queries.
@@ -46,8 +46,9 @@ pub(super) fn advance(
     b: &Body,
     swept: &continuous::SweptContact,
     tol: f64,
+    known: Option<&EndOverlap>,
 ) -> Option<PairContact> {
-    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, tol, scratch))
+    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, tol, known, scratch))
 }
 
 /// The rotation taking the unit `n` to the third axis (rows: two axes across n, then n).
@@ -387,11 +388,6 @@ impl Search<'_, '_> {
 /// the tolerance leaves a lower bound above half of it (see `Settle::settle`).
 pub(super) const NEAREST_SLACK: f32 = 0.02;
 
-/// Distance (mm) within which two candidates count as meeting for [`Search::meeting`]: far
-/// above the rounding of the boxes and of the planes (f64), so no meeting pair is missed (more
-/// are allowed).
-const MEETING_MM: f32 = 1e-4;
-
 impl Search<'_, '_> {
     /// Every candidate of each tooth (mesh triangle numbers) with a candidate of the other whose
     /// box comes within [`MEETING_MM`] of its box and that neither triangle's plane puts more than
@@ -600,6 +596,7 @@ fn advance_with(
     b: &Body,
     swept: &continuous::SweptContact,
     tol: f64,
+    known: Option<&EndOverlap>,
     s: &mut Scratch,
 ) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
@@ -633,6 +630,7 @@ fn advance_with(
         swept,
         tol,
         mu,
+        known,
     };
     // The candidates' triangle numbers are lent to the search (and the report) and put back.
     let (ids_a, ids_b) = (std::mem::take(&mut s.pa.ids), std::mem::take(&mut s.pb.ids));
