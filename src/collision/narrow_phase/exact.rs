@@ -177,6 +177,7 @@ pub fn query_knowing(a: &Body, b: &Body, known: Option<&EndOverlap>) -> Option<P
 
 fn query_at(a: &Body, b: &Body, tolerance: f32, known: Option<&EndOverlap>) -> Option<PairContact> {
     let tol = tolerance.max(1e-6) as f64;
+    let aim = Aim { tol, known };
     // The earliest leaf time bounds the first contact from below; from there the step is searched
     // in windows of growing length, each with only the leaf pairs that meet within it (a slerp and
     // lerp restricted to a sub-interval is the slerp and lerp between its end poses).
@@ -186,7 +187,7 @@ fn query_at(a: &Body, b: &Body, tolerance: f32, known: Option<&EndOverlap>) -> O
         a.motion.speed_bound(a.shape.max_rho as f64) + b.motion.speed_bound(b.shape.max_rho as f64);
     if whole <= WHOLE_STEP_TRAVEL_MM {
         let swept = continuous::query(a, b, true)?;
-        return advance(a, b, &swept, tol, known);
+        return advance(a, b, &swept, aim);
     }
     let first = continuous::query(a, b, false)?;
     let mut t = first.earliest();
@@ -213,7 +214,7 @@ fn query_at(a: &Body, b: &Body, tolerance: f32, known: Option<&EndOverlap>) -> O
             },
         );
         if let Some(swept) = continuous::query(&sa, &sb, true)
-            && let Some(mut c) = advance(&sa, &sb, &swept, tol, known)
+            && let Some(mut c) = advance(&sa, &sb, &swept, aim)
         {
             c.time_of_contact = (t + c.time_of_contact as f64 * (end - t)) as f32;
             if end < 1.0 {
@@ -237,13 +238,7 @@ const FLAT_PAIRS: usize = 4096;
 /// Conservative advancement over the bodies' whole motion, from the earliest meeting leaf time of
 /// `swept` (which must list every meeting leaf pair): flat for few candidates, hierarchical for
 /// many.
-fn advance(
-    a: &Body,
-    b: &Body,
-    swept: &continuous::SweptContact,
-    tol: f64,
-    known: Option<&EndOverlap>,
-) -> Option<PairContact> {
+fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact, aim: Aim) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
     let pairs: usize = swept
         .leaf_times
@@ -251,10 +246,18 @@ fn advance(
         .map(|&(i, j, _)| ta.triangles(i as usize).len() * tb.triangles(j as usize).len())
         .sum();
     if pairs <= FLAT_PAIRS {
-        flat::advance(a, b, swept, tol, known)
+        flat::advance(a, b, swept, aim)
     } else {
-        tree::advance(a, b, swept, tol, known)
+        tree::advance(a, b, swept, aim)
     }
+}
+
+/// What the advancement aims at: the gap it may leave (mm) and the overlap already known at some
+/// poses (see [`query_knowing`]).
+#[derive(Clone, Copy)]
+struct Aim<'k> {
+    tol: f64,
+    known: Option<&'k EndOverlap>,
 }
 
 /// What a step's search leads to.

@@ -5,11 +5,11 @@
 use glam::Vec3;
 
 use super::drift::Drift;
-use super::{Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
+use super::{Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::Body;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::collision::narrow_phase::{EndOverlap, PairContact, continuous};
+use crate::collision::narrow_phase::{PairContact, continuous};
 use crate::geometry::closest_points_facing_triangles;
 
 /// Allowance (mm) for the f32 rounding of a stored triangle-pair distance and of the poses it was
@@ -53,11 +53,10 @@ pub(super) fn advance(
     a: &Body,
     b: &Body,
     swept: &continuous::SweptContact,
-    tol: f64,
-    known: Option<&EndOverlap>,
+    aim: Aim,
 ) -> Option<PairContact> {
     SCRATCH.with_borrow_mut(|scratch| {
-        let contact = advance_with(a, b, swept, tol, known, scratch);
+        let contact = advance_with(a, b, swept, aim, scratch);
         // Lists of deep contacts between large meshes are not kept.
         if scratch.candidates.capacity() > KEEP_CANDIDATES {
             scratch.candidates = Vec::new();
@@ -73,8 +72,7 @@ fn advance_with(
     a: &Body,
     b: &Body,
     swept: &continuous::SweptContact,
-    tol: f64,
-    known: Option<&EndOverlap>,
+    aim: Aim,
     scratch: &mut Scratch,
 ) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
@@ -201,9 +199,9 @@ fn advance_with(
         a,
         b,
         swept,
-        tol,
+        tol: aim.tol,
         mu,
-        known,
+        known: aim.known,
     };
     let mut search = Flat {
         tris_a,

@@ -6,11 +6,11 @@ use glam::{Mat3, Vec3};
 
 use super::drift::Drift;
 use super::patch::{Patch, PatchNode};
-use super::{Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
+use super::{Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
 use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
-use crate::collision::narrow_phase::{Body, EndOverlap, PairContact, continuous};
+use crate::collision::narrow_phase::{Body, PairContact, continuous};
 use crate::geometry::{Aabb, Pose, Sphere, TriMesh, closest_points_facing_triangles};
 
 /// Per-thread scratch of the advancement, reused between queries.
@@ -45,10 +45,9 @@ pub(super) fn advance(
     a: &Body,
     b: &Body,
     swept: &continuous::SweptContact,
-    tol: f64,
-    known: Option<&EndOverlap>,
+    aim: Aim,
 ) -> Option<PairContact> {
-    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, tol, known, scratch))
+    SCRATCH.with_borrow_mut(|scratch| advance_with(a, b, swept, aim, scratch))
 }
 
 /// The rotation taking the unit `n` to the third axis (rows: two axes across n, then n).
@@ -595,8 +594,7 @@ fn advance_with(
     a: &Body,
     b: &Body,
     swept: &continuous::SweptContact,
-    tol: f64,
-    known: Option<&EndOverlap>,
+    aim: Aim,
     s: &mut Scratch,
 ) -> Option<PairContact> {
     let (ta, tb) = (&*a.shape.tree, &*b.shape.tree);
@@ -628,9 +626,9 @@ fn advance_with(
         a,
         b,
         swept,
-        tol,
+        tol: aim.tol,
         mu,
-        known,
+        known: aim.known,
     };
     // The candidates' triangle numbers are lent to the search (and the report) and put back.
     let (ids_a, ids_b) = (std::mem::take(&mut s.pa.ids), std::mem::take(&mut s.pb.ids));
