@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::{
     broad_phase::{BroadItem, candidate_pairs},
     motion::Motion,
-    narrow_phase::{Body, EndOverlap, Method, query},
+    narrow_phase::{Body, EndOverlap, Method, query_knowing},
     shape::{Circle, CollisionShape},
 };
 use crate::{
@@ -269,7 +269,7 @@ fn narrow_phase(
             circle: b.2.circle,
             motion: motion_of(b.3, b.4),
         };
-        let Some(hit) = query(settings.method, &body_a, &body_b) else {
+        let Some(hit) = query_knowing(settings.method, &body_a, &body_b, None) else {
             continue;
         };
         let contact = Contact {

@@ -49,8 +49,9 @@
 //! the other surface, so the search walks from them over the part of each surface inside the
 //! other instead of testing every vertex; the hierarchical search first narrows them to those
 //! near a candidate of the other tooth, which still holds every crossing one). A contact at the
-//! start of the motion also carries the meshes' overlap at its end ([`PairContact::end_overlap`],
-//! both searches), which a response needs to tell whether the contact deepens: every
+//! start of the motion also carries the meshes' overlap at its end when asked
+//! ([`query_knowing`], which a simulation's steps use; [`PairContact::end_overlap`]), which a
+//! response needs to tell whether the contact deepens: every
 //! triangle pair that meets at the end touches during the motion, so it is a candidate pair, and
 //! the walk goes from the candidates that meet at the end placement instead of the whole meshes'
 //! meeting triangles, which cost a search of both meshes' hierarchies. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
@@ -164,20 +165,30 @@ pub fn query(a: &Body, b: &Body) -> Option<PairContact> {
 
 /// The exact query leaving a gap of at most `tolerance` (mm, positive) at the reported contact.
 pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
-    query_at(a, b, tolerance, None)
+    let aim = Aim {
+        tol: tolerance.max(1e-6) as f64,
+        known: None,
+        end: false,
+    };
+    query_at(a, b, aim)
 }
 
-/// [`query`] for teeth whose overlap at the start poses may already be `known`: the overlap a
-/// contact carried from the end of the step before ([`PairContact::end_overlap`]), used when its
-/// poses are the start poses (the same depth and points the search would find, without walking
-/// the meshes again); otherwise ignored.
+/// [`query`] for a simulation's steps: a contact at the start of the step also carries the
+/// meshes' overlap at its end ([`PairContact::end_overlap`], which a response asks for; [`query`]
+/// leaves it out, as it costs a walk), and the overlap at the start poses may already be
+/// `known`: the overlap a contact carried from the end of the step before, used when its poses
+/// are the start poses (the same depth and points the search would find, without walking the
+/// meshes again); otherwise ignored.
 pub fn query_knowing(a: &Body, b: &Body, known: Option<&EndOverlap>) -> Option<PairContact> {
-    query_at(a, b, GAP_TOLERANCE_MM, known)
+    let aim = Aim {
+        tol: GAP_TOLERANCE_MM as f64,
+        known,
+        end: true,
+    };
+    query_at(a, b, aim)
 }
 
-fn query_at(a: &Body, b: &Body, tolerance: f32, known: Option<&EndOverlap>) -> Option<PairContact> {
-    let tol = tolerance.max(1e-6) as f64;
-    let aim = Aim { tol, known };
+fn query_at(a: &Body, b: &Body, aim: Aim) -> Option<PairContact> {
     // The earliest leaf time bounds the first contact from below; from there the step is searched
     // in windows of growing length, each with only the leaf pairs that meet within it (a slerp and
     // lerp restricted to a sub-interval is the slerp and lerp between its end poses).
@@ -252,12 +263,14 @@ fn advance(a: &Body, b: &Body, swept: &continuous::SweptContact, aim: Aim) -> Op
     }
 }
 
-/// What the advancement aims at: the gap it may leave (mm) and the overlap already known at some
-/// poses (see [`query_knowing`]).
+/// What the advancement aims at: the gap it may leave (mm), the overlap already known at some
+/// poses, and whether a contact at the start carries the overlap at the end (see
+/// [`query_knowing`]).
 #[derive(Clone, Copy)]
 struct Aim<'k> {
     tol: f64,
     known: Option<&'k EndOverlap>,
+    end: bool,
 }
 
 /// What a step's search leads to.
@@ -277,8 +290,10 @@ struct Settle<'x, 'y> {
     swept: &'x continuous::SweptContact,
     tol: f64,
     mu: f64,
-    /// The overlap already known at some poses (see [`query_knowing`]).
+    /// The overlap already known at some poses, and whether a contact at the start carries the
+    /// overlap at the end (see [`query_knowing`]).
     known: Option<&'x EndOverlap>,
+    end: bool,
 }
 
 impl Settle<'_, '_> {
@@ -430,7 +445,7 @@ fn advance_over(
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
         let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(mut c) => {
-                if t == 0.0 {
+                if t == 0.0 && ctx.end {
                     c.end_overlap = end_overlap(a, b, search);
                 }
                 return Some(c);

@@ -149,11 +149,18 @@ pub struct EndOverlap {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn query(method: Method, a: &Body, b: &Body) -> Option<PairContact> {
-    query_knowing(method, a, b, None)
+    if a.shape.tree.is_empty() || b.shape.tree.is_empty() {
+        return None;
+    }
+    match method {
+        Method::Exact => exact::query(a, b),
+        _ => query_knowing(method, a, b, None),
+    }
 }
 
-/// [`query`] for teeth whose overlap at the start poses may be `known` from the step before
-/// (the exact method uses it, see [`exact::query_knowing`]; the others ignore it).
+/// [`query`] for a simulation's steps: exact contacts at the start of the step carry the
+/// meshes' overlap at its end, and the overlap at the start poses may be `known` from the step
+/// before (see [`exact::query_knowing`]; the other methods ignore both).
 pub fn query_knowing(
     method: Method,
     a: &Body,

@@ -202,6 +202,7 @@ fn advance_with(
         tol: aim.tol,
         mu,
         known: aim.known,
+        end: aim.end,
     };
     let mut search = Flat {
         tris_a,
