@@ -22,7 +22,7 @@ use super::{
     motion::Motion,
     narrow_phase::{Body, Method, PairContact, spheres},
 };
-use crate::geometry::{NearContact, Pose, crossing_triangles, mesh_penetration_near};
+use crate::geometry::{Pose, crossing_triangles, mesh_penetration_near};
 
 /// A distance must fall by more than this (mm per step) to count as approaching.
 pub const APPROACH_MM: f32 = 1e-7;
@@ -103,20 +103,7 @@ fn end_gap(a: &Body, b: &Body) -> f32 {
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
     let (pa, pb) = (&a.motion.end, &b.motion.end);
     let (near_a, near_b) = crossing_triangles(ga.mesh_ref(), pa, gb.mesh_ref(), pb, MEETING_MM);
-    let (depth, _, _) = mesh_penetration_near(
-        NearContact {
-            mesh: ga.mesh_ref(),
-            stars: &ga.stars,
-            near: &near_a,
-        },
-        pa,
-        NearContact {
-            mesh: gb.mesh_ref(),
-            stars: &gb.stars,
-            near: &near_b,
-        },
-        pb,
-    );
+    let (depth, _, _) = mesh_penetration_near(ga.near(&near_a), pa, gb.near(&near_b), pb);
     -depth
 }
 

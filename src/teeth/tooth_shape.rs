@@ -12,7 +12,7 @@ use super::{
     memo::Memo,
     shape::{ToothResolution, ToothSolid},
 };
-use crate::geometry::{MeshRef, TriMesh, TriangleBvh, VertexStars};
+use crate::geometry::{MeshRef, NearContact, TriMesh, TriangleBvh, VertexStars};
 
 /// The geometry of one tooth in its local frame (see [`super::shape`] for the frame).
 #[derive(Debug)]
@@ -85,6 +85,16 @@ impl ToothGeometry {
         MeshRef {
             mesh: &self.mesh,
             bvh: &self.bvh,
+        }
+    }
+
+    /// This tooth's side of a penetration walk ([`crate::geometry::mesh_penetration_near`])
+    /// from its triangles `near`, which must hold every triangle meeting the other surface.
+    pub fn near<'a>(&'a self, near: &'a [u32]) -> NearContact<'a> {
+        NearContact {
+            mesh: self.mesh_ref(),
+            stars: &self.stars,
+            near,
         }
     }
 }

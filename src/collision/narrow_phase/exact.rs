@@ -88,7 +88,7 @@ use glam::Vec3;
 use super::lanes::Affine32;
 use super::{Body, EndOverlap, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion};
-use crate::geometry::{FacePlane, NearContact, mesh_penetration_near};
+use crate::geometry::{FacePlane, mesh_penetration_near};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -225,13 +225,10 @@ fn query_at(a: &Body, b: &Body, aim: Aim) -> Option<PairContact> {
             },
         );
         if let Some(swept) = continuous::query(&sa, &sb, true)
-            && let Some(mut c) = advance(&sa, &sb, &swept, aim)
+            // Only a window that ends with the motion can carry the overlap at its end.
+            && let Some(mut c) = advance(&sa, &sb, &swept, Aim { end: aim.end && end >= 1.0, ..aim })
         {
             c.time_of_contact = (t + c.time_of_contact as f64 * (end - t)) as f32;
-            if end < 1.0 {
-                // Found at the window's end, not the motion's.
-                c.end_overlap = None;
-            }
             return Some(c);
         }
         if end >= 1.0 {
@@ -288,12 +285,8 @@ struct Settle<'x, 'y> {
     a: &'x Body<'y>,
     b: &'x Body<'y>,
     swept: &'x continuous::SweptContact,
-    tol: f64,
+    aim: Aim<'x>,
     mu: f64,
-    /// The overlap already known at some poses, and whether a contact at the start carries the
-    /// overlap at the end (see [`query_knowing`]).
-    known: Option<&'x EndOverlap>,
-    end: bool,
 }
 
 impl Settle<'_, '_> {
@@ -316,14 +309,24 @@ impl Settle<'_, '_> {
     ) -> Settled {
         let q = q.map(|p| frame.pose_a.transform_point(p));
         let d = d as f64;
-        if d <= self.tol || last {
-            let c = report(self.a, self.b, self.swept, t, d, q, frame, ids, self.known);
+        if d <= self.aim.tol || last {
+            let c = report(
+                self.a,
+                self.b,
+                self.swept,
+                t,
+                d,
+                q,
+                frame,
+                ids,
+                self.aim.known,
+            );
             return Settled::Report(c);
         }
         if self.mu <= 0.0 {
             return Settled::Stuck;
         }
-        let h = 0.5 * self.tol;
+        let h = 0.5 * self.aim.tol;
         Settled::Step {
             h,
             plain: (low as f64 - h) / self.mu,
@@ -360,20 +363,9 @@ fn report(
         let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
         let (depth, pa, pb) = match known.filter(|k| k.poses == [frame.pose_a, frame.pose_b]) {
             Some(k) => (k.depth_mm, k.points[0], k.points[1]),
-            None => mesh_penetration_near(
-                NearContact {
-                    mesh: ga.mesh_ref(),
-                    stars: &ga.stars,
-                    near: ids_a,
-                },
-                &frame.pose_a,
-                NearContact {
-                    mesh: gb.mesh_ref(),
-                    stars: &gb.stars,
-                    near: ids_b,
-                },
-                &frame.pose_b,
-            ),
+            None => {
+                mesh_penetration_near(ga.near(ids_a), &frame.pose_a, gb.near(ids_b), &frame.pose_b)
+            }
         };
         if depth > 0.0 {
             contact.depth_mm = depth;
@@ -437,7 +429,7 @@ fn advance_over(
         // before the earliest leaf time, and each step keeps half the tolerance), so any pair
         // within the tolerance is a contact to report. At the start they may already
         // interpenetrate, which only the least distance (0) shows.
-        let enough = if t > 0.0 { ctx.tol as f32 } else { -1.0 };
+        let enough = if t > 0.0 { ctx.aim.tol as f32 } else { -1.0 };
         let (d, low, qa, qb) = search.least(axis, enough)?;
         axis = (qb - qa).normalize_or(axis);
         // Touching: the depth is searched from the candidates that meet.
@@ -445,7 +437,7 @@ fn advance_over(
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
         let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(mut c) => {
-                if t == 0.0 && ctx.end {
+                if t == 0.0 && ctx.aim.end {
                     c.end_overlap = end_overlap(a, b, search);
                 }
                 return Some(c);
@@ -478,20 +470,8 @@ fn end_overlap(a: &Body, b: &Body, search: &mut impl Candidates) -> Option<EndOv
     let poses = [a.motion.end, b.motion.end];
     let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    let (depth_mm, pa, pb) = mesh_penetration_near(
-        NearContact {
-            mesh: ga.mesh_ref(),
-            stars: &ga.stars,
-            near: &near_a,
-        },
-        &poses[0],
-        NearContact {
-            mesh: gb.mesh_ref(),
-            stars: &gb.stars,
-            near: &near_b,
-        },
-        &poses[1],
-    );
+    let (depth_mm, pa, pb) =
+        mesh_penetration_near(ga.near(&near_a), &poses[0], gb.near(&near_b), &poses[1]);
     Some(EndOverlap {
         poses,
         depth_mm,

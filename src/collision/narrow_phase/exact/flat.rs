@@ -199,10 +199,8 @@ fn advance_with(
         a,
         b,
         swept,
-        tol: aim.tol,
+        aim,
         mu,
-        known: aim.known,
-        end: aim.end,
     };
     let mut search = Flat {
         tris_a,

@@ -626,10 +626,8 @@ fn advance_with(
         a,
         b,
         swept,
-        tol: aim.tol,
+        aim,
         mu,
-        known: aim.known,
-        end: aim.end,
     };
     // The candidates' triangle numbers are lent to the search (and the report) and put back.
     let (ids_a, ids_b) = (std::mem::take(&mut s.pa.ids), std::mem::take(&mut s.pb.ids));
