@@ -270,6 +270,13 @@ struct Aim<'k> {
     end: bool,
 }
 
+impl<'k> Aim<'k> {
+    /// The known overlap, when it was found at the poses of `frame`.
+    fn known_at(&self, frame: &Frame) -> Option<&'k EndOverlap> {
+        (self.known).filter(|k| k.poses == [frame.pose_a, frame.pose_b])
+    }
+}
+
 /// What a step's search leads to.
 enum Settled {
     /// The contact to report.
@@ -319,7 +326,7 @@ impl Settle<'_, '_> {
                 q,
                 frame,
                 ids,
-                self.aim.known,
+                self.aim.known_at(frame),
             );
             return Settled::Report(c);
         }
@@ -346,6 +353,7 @@ fn report(
     q: [Vec3; 2],
     frame: &Frame,
     [ids_a, ids_b]: [&[u32]; 2],
+    // The overlap known at these poses.
     known: Option<&EndOverlap>,
 ) -> PairContact {
     let [qa, qb] = q;
@@ -361,7 +369,7 @@ fn report(
         // Touching or interpenetrating (only possible at the start): the candidates already
         // touch, so only the depth is left to find (or is known for these poses).
         let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-        let (depth, pa, pb) = match known.filter(|k| k.poses == [frame.pose_a, frame.pose_b]) {
+        let (depth, pa, pb) = match known {
             Some(k) => (k.depth_mm, k.points[0], k.points[1]),
             None => {
                 mesh_penetration_near(ga.near(ids_a), &frame.pose_a, gb.near(ids_b), &frame.pose_b)
@@ -432,8 +440,13 @@ fn advance_over(
         let enough = if t > 0.0 { ctx.aim.tol as f32 } else { -1.0 };
         let (d, low, qa, qb) = search.least(axis, enough)?;
         axis = (qb - qa).normalize_or(axis);
-        // Touching: the depth is searched from the candidates that meet.
-        let touching = if d == 0.0 { search.touching() } else { None };
+        // Touching: the depth is searched from the candidates that meet, unless it is known
+        // for these poses.
+        let touching = if d == 0.0 && ctx.aim.known_at(&frame).is_none() {
+            search.touching()
+        } else {
+            None
+        };
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
         let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(mut c) => {
