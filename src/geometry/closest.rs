@@ -96,7 +96,7 @@ pub struct TrianglePair {
 }
 
 /// Separating-axis test for two triangles in 3D; touching counts as intersecting. Exact up to
-/// rounding; the axes are the two face normals, the nine edge–edge cross products and, for
+/// f64 rounding of the f32 corners' differences (about 1e-16 of the triangles' size); the axes are the two face normals, the nine edge–edge cross products and, for
 /// (nearly) coplanar triangles, the in-plane edge normals.
 pub fn triangles_intersect(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> bool {
     triangles_within(t1, t2, 0.0)
@@ -106,9 +106,16 @@ pub fn triangles_intersect(t1: &[Vec3; 3], t2: &[Vec3; 3]) -> bool {
 /// separates the triangles by more than the margin, so every pair within the margin of each other
 /// (and some pairs farther apart) gives true.
 pub fn triangles_within(t1: &[Vec3; 3], t2: &[Vec3; 3], margin: f32) -> bool {
-    let separated = |axis: Vec3| -> bool {
+    // In f64 about the first triangle's first corner: there the differences of f32 coordinates
+    // are exact and every projection keeps about 1e-16 of its size, so sliver triangles lying a
+    // micrometre apart and nearly coplanar (a fine mesh's neighbouring strips) are told apart,
+    // which f32 projections of coordinates tens of millimetres large are not.
+    let o = t1[0].as_dvec3();
+    let (t1, t2) = (t1.map(|v| v.as_dvec3() - o), t2.map(|v| v.as_dvec3() - o));
+    let margin = f64::from(margin);
+    let separated = |axis: DVec3| -> bool {
         let len2 = axis.length_squared();
-        if len2 <= f32::MIN_POSITIVE {
+        if len2 <= f64::MIN_POSITIVE {
             return false;
         }
         let pad = if margin > 0.0 {
@@ -116,8 +123,8 @@ pub fn triangles_within(t1: &[Vec3; 3], t2: &[Vec3; 3], margin: f32) -> bool {
         } else {
             0.0
         };
-        let (mut min1, mut max1) = (f32::INFINITY, f32::NEG_INFINITY);
-        let (mut min2, mut max2) = (f32::INFINITY, f32::NEG_INFINITY);
+        let (mut min1, mut max1) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut min2, mut max2) = (f64::INFINITY, f64::NEG_INFINITY);
         for k in 0..3 {
             let a = axis.dot(t1[k]);
             let b = axis.dot(t2[k]);
@@ -639,6 +646,30 @@ mod tests {
                 2
             }] += 1;
         }
+    }
+
+    #[test]
+    fn sliver_strips_a_micrometre_apart_do_not_intersect() {
+        // Two strips of a generated root at 40,000 triangles: 14 µm wide, 1 mm long, nearly
+        // coplanar, the second wholly on one side of the first's plane by 1–3 µm (checked in
+        // exact rational arithmetic). f32 projections took them for crossing.
+        let t1 = tri(
+            [28.156425, -9.366802, -26.460337],
+            [28.143988, -9.367285, -26.468922],
+            [27.896626, -10.316576, -26.589489],
+        );
+        let t2 = tri(
+            [27.90808, -10.316132, -26.581585],
+            [27.639736, -11.266236, -26.716635],
+            [27.650167, -11.265831, -26.709436],
+        );
+        assert!(!triangles_intersect(&t1, &t2));
+        assert!(!triangles_intersect(&t2, &t1));
+        // Moved onto the first's plane, the second does meet it: the test still sees contact.
+        let n = (t1[1] - t1[0]).cross(t1[2] - t1[0]).normalize();
+        let off = n.dot(t2[0] - t1[0]);
+        let t3 = t2.map(|v| v - n * off);
+        assert!(triangles_within(&t1, &t3, 1e-4));
     }
 
     #[test]

@@ -342,3 +342,41 @@ fn scanned_crowns_get_full_medial_trees() {
         assert!(check_coverage(&tree, &g.mesh, DEFAULT_SPLIT_DEPTH).covered);
     }
 }
+
+/// Crowns at scan resolution (20,000 and 40,000 triangles) that the import used to refuse: a
+/// generated root whose star-shaped collar folded onto itself by less than single precision holds
+/// apart, nearly coplanar root strips a micrometre apart taken for crossing, and a jagged margin
+/// that needed more than ten rounds of cutting.
+#[test]
+fn scan_resolution_crowns_import() {
+    let d = normal();
+    let limits = RepairLimits::default();
+    for (triangles, number, seed) in [
+        (20000, 38, 3801),
+        (40000, 38, 3802),
+        (40000, 21, 2102),
+        (20000, 22, 2201),
+    ] {
+        let fdi = Fdi::new(number).unwrap();
+        let tooth = d.tooth(fdi).unwrap();
+        let defects = ScanDefects::typical(seed);
+        let scan = scan_like_crown(
+            fdi.arch(),
+            fdi.kind(),
+            &tooth.pose,
+            triangles,
+            &defects,
+            seed,
+        );
+        let name = format!("{fdi} at {triangles} triangles (seed {seed})");
+        let t = import_mesh(&scan.mesh, fdi, &curve(&d, fdi), &limits)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        t.geometry.mesh.validate_solid().unwrap();
+        check_reported(&scan, &t, &name);
+        let drift = unrepaired_drift(&scan, &t);
+        assert!(
+            drift <= 0.01,
+            "{name}: the unrepaired surface moved {drift} mm"
+        );
+    }
+}

@@ -24,8 +24,10 @@ use super::{
 use crate::geometry::{MeshError, TriMesh};
 use crate::teeth::fdi::Fdi;
 
-/// Rounds of cutting out self-intersecting patches before giving up.
-pub const MAX_CUTS: usize = 10;
+/// Rounds of cutting out self-intersecting patches before giving up. A scan-resolution crown
+/// whose jagged margin needs the star-shaped collar can take more than ten: each round cuts only
+/// a few edges (at least [`CUT_RADIUS_MM`]) around the crossings it finds.
+pub const MAX_CUTS: usize = 24;
 /// Rounds of trimming a folded margin before building the root on what is left.
 pub const MAX_TRIMS: usize = 16;
 /// The cervical margin of a crown is at least this many times as long as the crown's largest

@@ -125,7 +125,8 @@ pub fn close_with_root(
     let h0 = f.deepest + f64::from(gap);
     let apex_depth = f64::from(root_length).max(h0 + 0.3 * f64::from(root_length));
     let projected = f.project(mesh, l);
-    let outline = untangle(&projected, MIN_SEPARATION_MM).unwrap_or_else(|| star(&projected));
+    let outline = untangle(&projected, MIN_SEPARATION_MM)
+        .unwrap_or_else(|| star(&projected, MIN_SEPARATION_MM));
     // The collar's strips run from each margin vertex towards the focus, to the plane at h0.
     let to_h0 = (f.depth - h0) / (f.depth - f.deepest);
     let ring0: Vec<DVec2> = outline.iter().map(|&q| q * to_h0).collect();
@@ -356,11 +357,44 @@ fn untangle(p: &[DVec2], eps: f64) -> Option<Vec<DVec2>> {
     offending(&q, eps).is_empty().then_some(q)
 }
 
+/// A star-shaped polygon with one vertex per vertex of `p`, simple with room to spare at `eps`
+/// (no vertex [`offending`]) unless even a circle is not: the first of [`STAR_SMOOTHING`]'s
+/// smoothings ([`star_with`]) that is.
+///
+/// Strictly increasing angles alone make a simple polygon, but not one with room: where a jagged
+/// outline's backward steps were flattened, neighbouring vertices lie almost on one ray, and
+/// their radii, out and back in, fold the outline onto itself by less than a vertex's single
+/// precision can hold apart once the root's rings are stored. So the steps keep a share of the
+/// mean step, and when that is not enough, the angles are evened out and the radii averaged
+/// over wider windows, the last time over the whole outline (a circle).
+fn star(p: &[DVec2], eps: f64) -> Vec<DVec2> {
+    let mut outline = Vec::new();
+    for &(share, half) in &STAR_SMOOTHING {
+        outline = star_with(p, share, half);
+        if offending(&outline, eps).is_empty() {
+            break;
+        }
+    }
+    outline
+}
+
+/// Smoothings of [`star`], tried in turn: the least share of the mean angle step that each step
+/// keeps, and the half-width (vertices) of the window each radius is averaged over (capped at
+/// half the outline).
+pub const STAR_SMOOTHING: [(f64, usize); 4] = [
+    (0.25, SMOOTH),
+    (0.5, 4 * SMOOTH),
+    (1.0, 12 * SMOOTH),
+    (1.0, usize::MAX),
+];
+
 /// A star-shaped polygon with one vertex per vertex of `p`: angles about `p`'s centre made
-/// strictly increasing (the backward steps of a jagged outline flattened out), radii averaged
-/// over [`SMOOTH`] neighbours each side. Simple by construction.
-fn star(p: &[DVec2]) -> Vec<DVec2> {
+/// strictly increasing (the backward steps of a jagged outline flattened out, each step at least
+/// `share` of the mean one), radii averaged over `half` neighbours each side. Simple by
+/// construction.
+fn star_with(p: &[DVec2], share: f64, half: usize) -> Vec<DVec2> {
     let n = p.len();
+    let half = half.min(n.saturating_sub(1) / 2);
     let centre = area_centroid(p);
     let theta: Vec<f64> = p.iter().map(|q| (*q - centre).to_angle()).collect();
     let wrap = |x: f64| {
@@ -373,21 +407,22 @@ fn star(p: &[DVec2]) -> Vec<DVec2> {
     let total: f64 = steps.iter().sum();
     let radius = |i: usize| {
         let mut s = 0.0;
-        for k in 0..=2 * SMOOTH {
-            s += (p[(i + n + k - SMOOTH) % n] - centre).length();
+        for k in 0..=2 * half {
+            s += (p[(i + n + k - half) % n] - centre).length();
         }
-        (s / (2 * SMOOTH + 1) as f64).max(0.05)
+        (s / (2 * half + 1) as f64).max(0.05)
+    };
+    // Each step at least the share of the mean one and above zero.
+    let floored = |forward: Vec<f64>| -> Vec<f64> {
+        let least = (share * forward.iter().sum::<f64>() / n as f64).max(1e-9);
+        forward.into_iter().map(|s| s.max(least)).collect()
     };
     let (sign, forward): (f64, Vec<f64>) = if total.abs() > std::f64::consts::PI {
         // The centre is inside: keep each forward step, flatten the backward ones.
         let sign = total.signum();
-        let minimum = 1e-3 * std::f64::consts::TAU / n as f64;
         (
             sign,
-            steps
-                .iter()
-                .map(|s| (s * sign).max(0.0) + minimum)
-                .collect(),
+            floored(steps.iter().map(|s| (s * sign).max(0.0)).collect()),
         )
     } else {
         // The centre is outside the outline: spread the angles by arc length instead.
@@ -398,9 +433,7 @@ fn star(p: &[DVec2]) -> Vec<DVec2> {
         };
         (
             sign,
-            (0..n)
-                .map(|i| p[i].distance(p[(i + 1) % n]) + 1e-9)
-                .collect(),
+            floored((0..n).map(|i| p[i].distance(p[(i + 1) % n])).collect()),
         )
     };
     let scale = std::f64::consts::TAU / forward.iter().sum::<f64>();
@@ -459,7 +492,7 @@ mod tests {
             })
             .collect();
         assert!(!is_simple(&jagged, 1e-3));
-        let s = star(&jagged);
+        let s = star(&jagged, 1e-3);
         assert_eq!(s.len(), n);
         assert!(is_simple(&s, 1e-6));
         // The outline keeps its size.
