@@ -348,7 +348,7 @@ fn scanned_crowns_get_full_medial_trees() {
 /// apart, nearly coplanar root strips a micrometre apart taken for crossing, and a jagged margin
 /// that needed more than ten rounds of cutting.
 #[test]
-fn scan_resolution_crowns_import() {
+fn scan_resolution_crowns_once_refused_import() {
     let d = normal();
     let limits = RepairLimits::default();
     for (triangles, number, seed) in [
