@@ -370,6 +370,9 @@ pub(super) struct Deepest<'a> {
     /// The triangle of b's surface (b's frame) nearest the last sample measured: no sample is
     /// deeper than its distance from it.
     last: Option<[Vec3; 3]>,
+    /// A depth the result is known to reach (0 when none is known): samples whose bound is
+    /// below it are not measured.
+    floor: f32,
 }
 
 impl<'a> Deepest<'a> {
@@ -383,7 +386,17 @@ impl<'a> Deepest<'a> {
             b_box: b.bvh.root_aabb(),
             best: (0.0, origin, origin),
             last: None,
+            floor: 0.0,
         }
+    }
+
+    /// The same search, told that the deepest sample reaches at least `floor` (mm): a sample
+    /// whose bound is below it cannot be the deepest and is not measured. The result is the same
+    /// for every floor up to the deepest sample's depth (the deepest sample's bound is never
+    /// below it); with a higher floor the result may be shallower than the true one.
+    pub(super) fn with_floor(mut self, floor: f32) -> Self {
+        self.floor = floor;
+        self
     }
 
     /// A point of the first mesh (its frame) in b's frame.
@@ -418,7 +431,7 @@ impl<'a> Deepest<'a> {
             p.distance(closest_point_triangle(p, a, b, c)) * (1.0 + 1e-5) + 1e-5
         });
         let bound = bound.min(near);
-        if bound <= self.best.0 {
+        if bound <= self.best.0 || bound < self.floor {
             return bound;
         }
         let limit = bound * (1.0 + 1e-5) + 1e-5;

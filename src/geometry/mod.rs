@@ -45,7 +45,9 @@ pub use section::section_loops;
 pub use sphere::Sphere;
 pub use stars::VertexStars;
 pub use trimesh::{MeshError, TriMesh};
-pub use walk::{CARRY_LIMIT, NearContact, mesh_penetration_near};
+pub use walk::{
+    CARRY_LIMIT, NearContact, mesh_penetration_near, mesh_penetration_near_from, sample_depth,
+};
 
 /// The geometry tests' seeded source of uniform numbers in [−0.5, 0.5) (a linear congruential
 /// generator: small, fixed, and the same sequence on every machine).

@@ -60,9 +60,40 @@ pub fn mesh_penetration_near(
     b: NearContact,
     pose_b: &Pose,
 ) -> (f32, Vec3, Vec3) {
-    let (da, pa, qa) = Walk::new(&a, pose_a, &b, pose_b).deepest();
-    let (db, pb, qb) = Walk::new(&b, pose_b, &a, pose_a).deepest();
-    if da >= db { (da, pa, qa) } else { (db, qb, pb) }
+    let (depth, pa, pb, _) = mesh_penetration_near_from(a, pose_a, b, pose_b, 0.0);
+    (depth, pa, pb)
+}
+
+/// [`mesh_penetration_near`] told a depth that some sample point of either mesh reaches inside
+/// the other (`floor`, mm; for instance [`sample_depth`] of the deepest sample of an earlier
+/// placement), so that shallower samples are not measured. The result is the same for every
+/// floor up to the true estimate: each walk is exact when its own deepest sample reaches the
+/// floor, and when it does not, the other walk's does and wins the comparison. Also returns
+/// which mesh the deepest sample lies on (`false`: the first, whose point comes first).
+pub fn mesh_penetration_near_from(
+    a: NearContact,
+    pose_a: &Pose,
+    b: NearContact,
+    pose_b: &Pose,
+    floor: f32,
+) -> (f32, Vec3, Vec3, bool) {
+    let (da, pa, qa) = Walk::new(&a, pose_a, &b, pose_b, floor).deepest();
+    let (db, pb, qb) = Walk::new(&b, pose_b, &a, pose_a, floor).deepest();
+    if da >= db {
+        (da, pa, qa, false)
+    } else {
+        (db, qb, pb, true)
+    }
+}
+
+/// The depth inside `other` (posed by `pose_other`) of a point `local` of a mesh posed by
+/// `pose`, or None when the point is outside: for a sample point of that mesh (a vertex or a
+/// triangle's centroid), a floor that [`mesh_penetration_near_from`] may be told, less the
+/// rounding of mapping a point found elsewhere back to `local`.
+pub fn sample_depth(local: Vec3, pose: &Pose, other: MeshRef, pose_other: &Pose) -> Option<f32> {
+    let mut deepest = Deepest::new(pose, other, pose_other);
+    let p = deepest.place(local);
+    deepest.inside(p).then(|| deepest.depth(p, f32::INFINITY))
 }
 
 /// Most near triangles of the other side against which the walk carries inside or out along
@@ -91,7 +122,13 @@ struct Walk<'a> {
 }
 
 impl<'a> Walk<'a> {
-    fn new(a: &NearContact<'a>, pose_a: &Pose, b: &NearContact<'a>, pose_b: &Pose) -> Self {
+    fn new(
+        a: &NearContact<'a>,
+        pose_a: &Pose,
+        b: &NearContact<'a>,
+        pose_b: &Pose,
+        floor: f32,
+    ) -> Self {
         let others = (b.near.len() <= CARRY_LIMIT).then(|| {
             SegmentTargets::new(
                 b.near
@@ -109,7 +146,7 @@ impl<'a> Walk<'a> {
             side: vec![Side::Unknown; a.mesh.mesh.vertices.len()],
             seen_triangle: vec![false; a.mesh.mesh.triangles.len()],
             inside: Vec::new(),
-            deepest: Deepest::new(pose_a, b.mesh, pose_b),
+            deepest: Deepest::new(pose_a, b.mesh, pose_b).with_floor(floor),
         }
     }
 
@@ -253,8 +290,8 @@ mod tooth_tests {
                 meeting(&b.mesh, &pose_b, &a.mesh, &pose_a),
             );
             let whole = mesh_penetration(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b);
-            let walk = |near_a: &[u32], near_b: &[u32]| {
-                mesh_penetration_near(
+            let walk_from = |near_a: &[u32], near_b: &[u32], floor: f32| {
+                mesh_penetration_near_from(
                     NearContact {
                         mesh: a.mesh_ref(),
                         stars: &a.stars,
@@ -267,8 +304,35 @@ mod tooth_tests {
                         near: near_b,
                     },
                     &pose_b,
+                    floor,
                 )
             };
+            let walk = |near_a: &[u32], near_b: &[u32]| {
+                let (d, p, q, _) = walk_from(near_a, near_b, 0.0);
+                (d, p, q)
+            };
+            // Told a floor up to the true depth, the walk finds the same; the deepest sample's
+            // depth, found again from its place, is such a floor.
+            let (d, p, q, on_b) = walk_from(&near_a, &near_b, 0.0);
+            if d > 0.0 {
+                let (other, pose_own, pose_other) = if on_b {
+                    (&a, &pose_b, &pose_a)
+                } else {
+                    (&b, &pose_a, &pose_b)
+                };
+                let sample = if on_b { q } else { p };
+                let local = pose_own.inverse().transform_point(sample);
+                let again = sample_depth(local, pose_own, other.mesh_ref(), pose_other).unwrap();
+                assert!((again - d).abs() < 1e-4, "case {case}: {again} against {d}");
+                for floor in [d, 0.5 * d, again - 1e-4] {
+                    let (df, pf, qf, side) = walk_from(&near_a, &near_b, floor);
+                    assert_eq!(
+                        (df, pf, qf, side),
+                        (d, p, q, on_b),
+                        "case {case}, floor {floor}"
+                    );
+                }
+            }
             // From the meeting triangles, and from every triangle (more than are needed, as the
             // exact stage's candidates are): sides carried against all of the other's.
             let every = |n: usize| (0..n as u32).collect::<Vec<_>>();

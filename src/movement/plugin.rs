@@ -25,8 +25,8 @@ use super::{
 };
 use crate::{
     collision::{
-        CollisionSettings, CollisionSystems, Contacts, PairContact, ToothCollider, ToothMotion,
-        motion::Motion,
+        CollisionSettings, CollisionSystems, Contacts, EndOverlap, PairContact, ToothCollider,
+        ToothMotion, motion::Motion,
     },
     simulation::{SimulationSystems, ensure_schedule},
     teeth::{ActiveCase, Dentition, Extracted, Load, Tooth, Wire, WireModel},
@@ -467,9 +467,7 @@ fn resolve(
                 contact.points.swap(0, 1);
                 contact.normal = -contact.normal;
                 contact.leaf_pairs.iter_mut().for_each(|p| *p = (p.1, p.0));
-                if let Some(e) = &mut contact.end_overlap {
-                    e.poses.swap(0, 1);
-                }
+                contact.end_overlap = contact.end_overlap.map(EndOverlap::swapped);
                 (j, i)
             };
             found.push(Found { a, b, contact });

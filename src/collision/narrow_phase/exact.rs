@@ -88,7 +88,7 @@ use glam::Vec3;
 use super::lanes::Affine32;
 use super::{Body, EndOverlap, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion};
-use crate::geometry::{FacePlane, mesh_penetration_near};
+use crate::geometry::{FacePlane, mesh_penetration_near, mesh_penetration_near_from, sample_depth};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -451,7 +451,7 @@ fn advance_over(
         let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
             Settled::Report(mut c) => {
                 if t == 0.0 && ctx.aim.end {
-                    c.end_overlap = end_overlap(a, b, search);
+                    c.end_overlap = end_overlap(a, b, search, ctx.aim.known);
                 }
                 return Some(c);
             }
@@ -479,18 +479,50 @@ fn advance_over(
 /// so it is a candidate pair (see the module doc). So the depth is the one the walk finds from
 /// the whole meshes' meeting triangles, without searching the whole meshes for them. `None` when
 /// the search does not list the meeting candidates.
-fn end_overlap(a: &Body, b: &Body, search: &mut impl Candidates) -> Option<EndOverlap> {
+///
+/// The deepest sample of an overlap `known` before (the last step's, for a resting contact),
+/// placed at the end, reaches a depth the overlap there reaches too: the walk is told it and
+/// skips the samples that cannot be deeper (the result is the same).
+fn end_overlap(
+    a: &Body,
+    b: &Body,
+    search: &mut impl Candidates,
+    known: Option<&EndOverlap>,
+) -> Option<EndOverlap> {
     let poses = [a.motion.end, b.motion.end];
     let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    let (depth_mm, pa, pb) =
-        mesh_penetration_near(ga.near(&near_a), &poses[0], gb.near(&near_b), &poses[1]);
+    let floor = known
+        .and_then(|k| k.deepest)
+        .and_then(|(side, local)| {
+            let other = [gb, ga][side].mesh_ref();
+            sample_depth(local, &poses[side], other, &poses[1 - side])
+        })
+        .map_or(0.0, |d| d - FLOOR_SLACK_MM);
+    let (depth_mm, pa, pb, on_b) = mesh_penetration_near_from(
+        ga.near(&near_a),
+        &poses[0],
+        gb.near(&near_b),
+        &poses[1],
+        floor,
+    );
+    let side = usize::from(on_b);
+    let deepest = (depth_mm > 0.0).then(|| {
+        let sample = [pa, pb][side];
+        (side, poses[side].inverse().transform_point(sample))
+    });
     Some(EndOverlap {
         poses,
         depth_mm,
         points: [pa, pb],
+        deepest,
     })
 }
+
+/// What a known deepest sample's depth is lowered by before it bounds a new search from below
+/// (mm): its place, mapped back from the world, differs from the sample's by single-precision
+/// rounding (about 10⁻⁶ mm at a tooth's size), which this covers many times over.
+const FLOOR_SLACK_MM: f32 = 1e-4;
 
 /// Both teeth at one time, seen from the first tooth.
 struct Frame {

@@ -114,6 +114,21 @@ pub struct EndOverlap {
     /// The deepest point with the nearest point of the other surface (world): on the first
     /// tooth's side, then on the second's, as [`PairContact::points`] of an overlap.
     pub points: [Vec3; 2],
+    /// The deepest sample point (a vertex or triangle centroid): the tooth it lies on (0 the
+    /// first, 1 the second) and its place in that tooth's mesh frame. At the next placement its
+    /// depth is one the overlap reaches, which lets the next search skip shallower samples
+    /// ([`crate::geometry::mesh_penetration_near_from`]). None when nothing overlaps.
+    pub deepest: Option<(usize, Vec3)>,
+}
+
+impl EndOverlap {
+    /// The same overlap seen with the two teeth's roles swapped.
+    pub fn swapped(mut self) -> Self {
+        self.poses.swap(0, 1);
+        self.points.swap(0, 1);
+        self.deepest = self.deepest.map(|(side, local)| (1 - side, local));
+        self
+    }
 }
 
 /// Runs `method` on a pair of teeth moving over one step: the first contact (or, for the discrete

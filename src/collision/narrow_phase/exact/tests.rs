@@ -236,7 +236,7 @@ fn end_overlap_at(vertices: u32) {
     let [a, b] = molar_and_premolar_at(vertices);
     let towards = (b.1.translation - a.1.translation).normalize();
     let mut rng = Rng(0x0e0d_0f57);
-    let (mut carried, mut apart, mut deeper, mut known) = (0, 0, 0, 0);
+    let (mut carried, mut apart, mut deeper, mut known, mut floored) = (0, 0, 0, 0, 0);
     for case in 0..40 {
         let start = Pose::new(
             a.1.rotation,
@@ -270,6 +270,12 @@ fn end_overlap_at(vertices: u32) {
         };
         carried += 1;
         assert_eq!(c.time_of_contact, 0.0, "case {case}");
+        // The deepest sample's place in its tooth's frame is the deepest point reported.
+        if let Some((side, local)) = e.deepest {
+            let at = e.poses[side].transform_point(local);
+            assert!(at.distance(e.points[side]) < 1e-4, "case {case}");
+            floored += 1;
+        }
         assert_eq!(e.poses, [ma.end, mb.end], "case {case}");
         let whole = mesh_penetration(
             a.0.geometry.mesh_ref(),
@@ -334,9 +340,10 @@ fn end_overlap_at(vertices: u32) {
         }
     }
     eprintln!(
-        "{vertices} vertices: {carried} carried, {apart} end apart, {deeper} deepen, {known} known"
+        "{vertices} vertices: {carried} carried, {apart} end apart, {deeper} deepen, {known} known, {floored} with a deepest sample"
     );
     assert!(carried > 25 && apart > 2 && deeper > 5 && carried - deeper > 5 && known > 10);
+    assert!(floored > 10);
 }
 
 /// Teeth 16 and 15 of the normal case at scan resolution (10,100 vertices), with medial sphere
