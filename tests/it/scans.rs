@@ -23,6 +23,30 @@ fn curve(d: &Dentition, fdi: Fdi) -> ArchCurve {
     ArchCurve::new(&d.arch_forms[usize::from(fdi.arch() == Arch::Lower)])
 }
 
+/// A scan-like crown of tooth `fdi` where `d` places it, with the typical defects of `seed`.
+fn typical_scan(d: &Dentition, fdi: Fdi, triangles: usize, seed: u64) -> ScanLikeCrown {
+    scan_of(d, fdi, triangles, &ScanDefects::typical(seed), seed)
+}
+
+/// A scan-like crown of tooth `fdi` where `d` places it, with `defects`.
+fn scan_of(
+    d: &Dentition,
+    fdi: Fdi,
+    triangles: usize,
+    defects: &ScanDefects,
+    seed: u64,
+) -> ScanLikeCrown {
+    let tooth = d.tooth(fdi).unwrap();
+    scan_like_crown(
+        fdi.arch(),
+        fdi.kind(),
+        &tooth.pose,
+        triangles,
+        defects,
+        seed,
+    )
+}
+
 /// The largest distance from a vertex of the scan's reference surface outside every defect's
 /// site and every place the import reports cutting, to the imported tooth's surface (mm): the
 /// one-sided Hausdorff distance of the unrepaired surface, measured at its vertices.
@@ -112,17 +136,8 @@ fn scan_like_crowns_with_real_defects_import() {
     let mut placed = [0usize; 6];
     for (r, triangles) in [300usize, 700, 1200, 3000].into_iter().enumerate() {
         for fdi in Fdi::all() {
-            let tooth = d.tooth(fdi).unwrap();
             let seed = u64::from(fdi.number()) * 100 + r as u64;
-            let defects = ScanDefects::typical(seed);
-            let scan = scan_like_crown(
-                fdi.arch(),
-                fdi.kind(),
-                &tooth.pose,
-                triangles,
-                &defects,
-                seed,
-            );
+            let scan = typical_scan(&d, fdi, triangles, seed);
             let p = scan.placed;
             for (n, k) in placed
                 .iter_mut()
@@ -255,7 +270,6 @@ fn heavily_damaged_crowns_never_panic_and_import_as_solids_or_are_refused() {
     let mut imported = 0;
     for seed in 0..40u64 {
         let fdi = Fdi::all().nth((seed * 7 % 32) as usize).unwrap();
-        let tooth = d.tooth(fdi).unwrap();
         // Up to five of each defect, far beyond what scans have.
         let base = ScanDefects::typical(seed);
         let many = |n: usize| n * 2 + (seed % 2) as usize;
@@ -269,14 +283,7 @@ fn heavily_damaged_crowns_never_panic_and_import_as_solids_or_are_refused() {
             ..base
         };
         let triangles = 300 + (seed as usize * 397) % 2500;
-        let scan = scan_like_crown(
-            fdi.arch(),
-            fdi.kind(),
-            &tooth.pose,
-            triangles,
-            &defects,
-            seed,
-        );
+        let scan = scan_of(&d, fdi, triangles, &defects, seed);
         if let Ok(t) = import_mesh(&scan.mesh, fdi, &curve(&d, fdi), &limits) {
             t.geometry.mesh.validate_solid().unwrap();
             imported += 1;
@@ -358,16 +365,7 @@ fn scan_resolution_crowns_once_refused_import() {
         (20000, 22, 2201),
     ] {
         let fdi = Fdi::new(number).unwrap();
-        let tooth = d.tooth(fdi).unwrap();
-        let defects = ScanDefects::typical(seed);
-        let scan = scan_like_crown(
-            fdi.arch(),
-            fdi.kind(),
-            &tooth.pose,
-            triangles,
-            &defects,
-            seed,
-        );
+        let scan = typical_scan(&d, fdi, triangles, seed);
         let name = format!("{fdi} at {triangles} triangles (seed {seed})");
         let t = import_mesh(&scan.mesh, fdi, &curve(&d, fdi), &limits)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
