@@ -524,6 +524,13 @@ fn end_overlap(
 /// rounding (about 10⁻⁶ mm at a tooth's size), which this covers many times over.
 const FLOOR_SLACK_MM: f32 = 1e-4;
 
+/// The candidates (mesh triangle numbers `ids`) whose `hit` flag is set, in order.
+fn marked(hit: &[bool], ids: &[u32]) -> Vec<u32> {
+    (hit.iter().zip(ids))
+        .filter_map(|(&h, &id)| h.then_some(id))
+        .collect()
+}
+
 /// Both teeth at one time, seen from the first tooth.
 struct Frame {
     pose_a: crate::geometry::Pose,

@@ -5,7 +5,9 @@
 use glam::Vec3;
 
 use super::drift::Drift;
-use super::{Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
+use super::{
+    Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, marked, relative,
+};
 use crate::collision::motion::{Motion, NodeCache};
 use crate::collision::narrow_phase::Body;
 use crate::collision::narrow_phase::lanes::Affine32;
@@ -334,12 +336,7 @@ impl Candidates for Flat<'_> {
                 hit[1][y] = true;
             }
         }
-        let pick = |hit: &[bool], ids: &[u32]| -> Vec<u32> {
-            (hit.iter().zip(ids))
-                .filter_map(|(&h, &id)| h.then_some(id))
-                .collect()
-        };
-        Some([pick(&hit[0], self.ids_a), pick(&hit[1], self.ids_b)])
+        Some([marked(&hit[0], self.ids_a), marked(&hit[1], self.ids_b)])
     }
 
     fn extend(&mut self, drift: &Drift, mu: f64, h: f64, plain: f64, first: f64) -> f64 {

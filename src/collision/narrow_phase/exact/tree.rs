@@ -6,7 +6,9 @@ use glam::{Mat3, Vec3};
 
 use super::drift::Drift;
 use super::patch::{Patch, PatchNode};
-use super::{Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, relative};
+use super::{
+    Aim, Candidates, Frame, MEETING_MM, PlacedTri, Settle, advance_over, marked, relative,
+};
 use crate::collision::CompactTree;
 use crate::collision::motion::NodeCache;
 use crate::collision::narrow_phase::lanes::Affine32;
@@ -439,12 +441,7 @@ impl Search<'_, '_> {
             }
         }
         self.s.stack = stack;
-        let pick = |side: usize| -> Vec<u32> {
-            (hit[side].iter().zip(self.ids[side]))
-                .filter_map(|(&h, &id)| h.then_some(id))
-                .collect()
-        };
-        [pick(0), pick(1)]
+        [marked(&hit[0], self.ids[0]), marked(&hit[1], self.ids[1])]
     }
 }
 
