@@ -18,7 +18,7 @@ pub(crate) mod sampling;
 pub mod shape;
 
 pub use motion::Motion;
-pub use narrow_phase::{Body, EndOverlap, Method, PairContact, query, query_knowing};
+pub use narrow_phase::{Body, EndOverlap, KnownInside, Method, PairContact, query, query_knowing};
 #[cfg(feature = "ecs")]
 pub use plugin::{
     CollisionPlugin, CollisionSettings, CollisionSystems, Contact, ContactStarted, Contacts,

@@ -431,7 +431,7 @@ impl<'a> Deepest<'a> {
             p.distance(closest_point_triangle(p, a, b, c)) * (1.0 + 1e-5) + 1e-5
         });
         let bound = bound.min(near);
-        if bound <= self.best.0 || bound < self.floor {
+        if !self.can_exceed(bound) {
             return bound;
         }
         let limit = bound * (1.0 + 1e-5) + 1e-5;
@@ -445,6 +445,12 @@ impl<'a> Deepest<'a> {
             self.best = (d, p, q);
         }
         d
+    }
+
+    /// Whether a sample whose depth is at most `bound` could be deeper than the deepest so far
+    /// and reach the floor: [`Self::depth`] measures only such samples.
+    pub(super) fn can_exceed(&self, bound: f32) -> bool {
+        bound > self.best.0 && bound >= self.floor
     }
 
     /// Whether the point (the first mesh's frame) lies inside b; the deepest so far is kept.

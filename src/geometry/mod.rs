@@ -46,7 +46,8 @@ pub use sphere::Sphere;
 pub use stars::VertexStars;
 pub use trimesh::{MeshError, TriMesh};
 pub use walk::{
-    CARRY_LIMIT, NearContact, mesh_penetration_near, mesh_penetration_near_from, sample_depth,
+    CARRY_LIMIT, InsideSamples, NearContact, Penetration, mesh_penetration_near,
+    mesh_penetration_near_from, sample_depth,
 };
 
 /// The geometry tests' seeded source of uniform numbers in [−0.5, 0.5) (a linear congruential

@@ -3,6 +3,8 @@
 
 use glam::Vec3;
 
+pub use rewalk::InsideSamples;
+
 use super::{
     aabb::Aabb,
     mesh_distance::{Deepest, MeshRef},
@@ -60,8 +62,8 @@ pub fn mesh_penetration_near(
     b: NearContact,
     pose_b: &Pose,
 ) -> (f32, Vec3, Vec3) {
-    let (depth, pa, pb, _) = mesh_penetration_near_from(a, pose_a, b, pose_b, 0.0);
-    (depth, pa, pb)
+    let p = mesh_penetration_near_from(a, pose_a, b, pose_b, 0.0);
+    (p.depth, p.points[0], p.points[1])
 }
 
 /// [`mesh_penetration_near`] told a depth that some sample point of either mesh reaches inside
@@ -70,19 +72,53 @@ pub fn mesh_penetration_near(
 /// floor up to the true estimate: each walk is exact when its own deepest sample reaches the
 /// floor, and when it does not, the other walk's does and wins the comparison. Also returns
 /// which mesh the deepest sample lies on (`false`: the first, whose point comes first).
+///
+/// The result also keeps every sample found inside with an upper bound of its depth
+/// ([`Penetration::inside`]), from which a later placement of the same meshes may be searched
+/// without walking ([`InsideSamples::rewalk`]).
 pub fn mesh_penetration_near_from(
     a: NearContact,
     pose_a: &Pose,
     b: NearContact,
     pose_b: &Pose,
     floor: f32,
-) -> (f32, Vec3, Vec3, bool) {
-    let (da, pa, qa) = Walk::new(&a, pose_a, &b, pose_b, floor).deepest();
-    let (db, pb, qb) = Walk::new(&b, pose_b, &a, pose_a, floor).deepest();
-    if da >= db {
-        (da, pa, qa, false)
-    } else {
-        (db, qb, pb, true)
+) -> Penetration {
+    let (deepest_a, found_a) = Walk::new(&a, pose_a, &b, pose_b, floor).deepest();
+    let (deepest_b, found_b) = Walk::new(&b, pose_b, &a, pose_a, floor).deepest();
+    let inside = InsideSamples::walked([a.mesh, b.mesh], [pose_a, pose_b], [found_a, found_b]);
+    Penetration::of(deepest_a, deepest_b, inside)
+}
+
+/// What [`mesh_penetration_near_from`] and [`InsideSamples::rewalk`] find.
+#[derive(Clone, Debug)]
+pub struct Penetration {
+    /// The depth of the deepest sample (mm; 0 when no sample lies inside the other mesh).
+    pub depth: f32,
+    /// The deepest point and the nearest point of the other surface (world), the first mesh's
+    /// point first (as [`mesh_penetration_near`]).
+    pub points: [Vec3; 2],
+    /// Whether the deepest sample lies on the second mesh.
+    pub on_b: bool,
+    /// The samples found inside, for a later search of the same meshes.
+    pub inside: InsideSamples,
+}
+
+impl Penetration {
+    /// The deeper of the two walks' results (the first's on a tie), each (depth, sample point,
+    /// nearest point of the other surface).
+    fn of(a: (f32, Vec3, Vec3), b: (f32, Vec3, Vec3), inside: InsideSamples) -> Self {
+        let ((da, pa, qa), (db, pb, qb)) = (a, b);
+        let (depth, points, on_b) = if da >= db {
+            (da, [pa, qa], false)
+        } else {
+            (db, [qb, pb], true)
+        };
+        Self {
+            depth,
+            points,
+            on_b,
+            inside,
+        }
     }
 }
 
@@ -118,6 +154,9 @@ struct Walk<'a> {
     side: Vec<Side>,
     seen_triangle: Vec<bool>,
     inside: Vec<u32>,
+    /// Every sample found inside (see [`InsideSamples`] for the numbering) with an upper bound
+    /// of its depth.
+    found: Vec<(u32, f32)>,
     deepest: Deepest<'a>,
 }
 
@@ -146,13 +185,14 @@ impl<'a> Walk<'a> {
             side: vec![Side::Unknown; a.mesh.mesh.vertices.len()],
             seen_triangle: vec![false; a.mesh.mesh.triangles.len()],
             inside: Vec::new(),
+            found: Vec::new(),
             deepest: Deepest::new(pose_a, b.mesh, pose_b).with_floor(floor),
         }
     }
 
     /// Depth, point (world) and nearest point of b's surface (world), as
-    /// [`super::mesh_penetration`].
-    fn deepest(mut self) -> (f32, Vec3, Vec3) {
+    /// [`super::mesh_penetration`], and the samples found inside with bounds of their depths.
+    fn deepest(mut self) -> ((f32, Vec3, Vec3), Vec<(u32, f32)>) {
         for &t in self.a.near {
             self.triangle(t);
         }
@@ -165,7 +205,7 @@ impl<'a> Walk<'a> {
                 self.triangle(t);
             }
         }
-        self.deepest.result()
+        (self.deepest.result(), self.found)
     }
 
     fn triangle(&mut self, t: u32) {
@@ -184,12 +224,16 @@ impl<'a> Walk<'a> {
         self.alone(base, start);
         // The centroid taken in the mesh's frame, as the whole-mesh search takes it.
         let centroid = self.deepest.place((local[0] + local[1] + local[2]) / 3.0);
-        self.sample(base, start, centroid);
+        if let Side::Inside(bound) = self.sample(base, start, centroid) {
+            let vertices = self.a.mesh.mesh.vertices.len() as u32;
+            self.found.push((vertices + t, bound));
+        }
         for (c, p) in corners.into_iter().zip(placed) {
             if self.side[c as usize] == Side::Unknown {
                 self.side[c as usize] = self.sample(base, start, p);
-                if self.side[c as usize] != Side::Outside {
+                if let Side::Inside(bound) = self.side[c as usize] {
                     self.inside.push(c);
+                    self.found.push((c, bound));
                 }
             }
         }
@@ -203,7 +247,9 @@ impl<'a> Walk<'a> {
         }
         self.side[v as usize] = if self.deepest.inside(p) {
             self.inside.push(v);
-            Side::Inside(self.deepest.depth(p, f32::INFINITY))
+            let bound = self.deepest.depth(p, f32::INFINITY);
+            self.found.push((v, bound));
+            Side::Inside(bound)
         } else {
             Side::Outside
         };
@@ -229,6 +275,8 @@ impl<'a> Walk<'a> {
         Side::Inside(self.deepest.depth(p, bound))
     }
 }
+mod rewalk;
+
 /// The penetration walk checked on real teeth (kept here, with the test-only use of the teeth
 /// above this layer, so that the layer check's test-block rule covers it).
 #[cfg(test)]
@@ -291,7 +339,7 @@ mod tooth_tests {
             );
             let whole = mesh_penetration(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b);
             let walk_from = |near_a: &[u32], near_b: &[u32], floor: f32| {
-                mesh_penetration_near_from(
+                let p = mesh_penetration_near_from(
                     NearContact {
                         mesh: a.mesh_ref(),
                         stars: &a.stars,
@@ -305,7 +353,8 @@ mod tooth_tests {
                     },
                     &pose_b,
                     floor,
-                )
+                );
+                (p.depth, p.points[0], p.points[1], p.on_b)
             };
             let walk = |near_a: &[u32], near_b: &[u32]| {
                 let (d, p, q, _) = walk_from(near_a, near_b, 0.0);

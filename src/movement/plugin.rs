@@ -459,7 +459,7 @@ fn resolve(
                 normal: c.normal,
                 depth_mm: c.depth_mm,
                 leaf_pairs: c.leaf_pairs.clone(),
-                end_overlap: c.end_overlap,
+                end_overlap: c.end_overlap.clone(),
             };
             let (a, b) = if i < j {
                 (i, j)

@@ -86,9 +86,13 @@
 use glam::Vec3;
 
 use super::lanes::Affine32;
-use super::{Body, EndOverlap, PairContact, continuous};
+use std::sync::Arc;
+
+use super::{Body, EndOverlap, KnownInside, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion};
-use crate::geometry::{FacePlane, mesh_penetration_near, mesh_penetration_near_from, sample_depth};
+use crate::geometry::{
+    FacePlane, Penetration, mesh_penetration_near, mesh_penetration_near_from, sample_depth,
+};
 
 /// Largest gap left between teeth reported as touching (mm).
 pub const GAP_TOLERANCE_MM: f32 = 0.01;
@@ -275,12 +279,27 @@ impl<'k> Aim<'k> {
     fn known_at(&self, frame: &Frame) -> Option<&'k EndOverlap> {
         (self.known).filter(|k| k.poses == [frame.pose_a, frame.pose_b])
     }
+
+    /// The meshes' overlap at the poses of `frame` (depth, and the points as
+    /// [`PairContact::points`]) when the known overlap tells it without a walk: found at these
+    /// poses, or from the samples it kept ([`rewalk_known`]).
+    fn overlap_at(&self, a: &Body, b: &Body, frame: &Frame) -> Option<Overlap> {
+        if let Some(k) = self.known_at(frame) {
+            return Some((k.depth_mm, k.points));
+        }
+        let poses = [frame.pose_a, frame.pose_b];
+        let floor = floor_of(a, b, poses, self.known);
+        rewalk_known(a, b, poses, self.known, floor).map(|p| (p.depth, p.points))
+    }
 }
+
+/// An overlap of the meshes: its depth (mm) and points (world, as [`PairContact::points`]).
+type Overlap = (f32, [Vec3; 2]);
 
 /// What a step's search leads to.
 enum Settled {
     /// The contact to report.
-    Report(PairContact),
+    Report(Box<PairContact>),
     /// Nothing moves: no contact.
     Stuck,
     /// Advance: half the tolerance and the plain step.
@@ -298,7 +317,8 @@ struct Settle<'x, 'y> {
 
 impl Settle<'_, '_> {
     /// The search found the gap `d` between `q` (first tooth's frame) at time `t`, and that no
-    /// candidate pair is nearer than `low` (at most d): within the tolerance, or at the `last`
+    /// candidate pair is nearer than `low` (at most d), and for teeth touching maybe their
+    /// overlap (depth and points, world): within the tolerance, or at the `last`
     /// step, the contact is reported here (still never after the meshes' contact); otherwise
     /// every pair is at least `low` apart and closes at most μ per unit time, so a plain step of
     /// (low − h)/μ keeps h, half the tolerance (the searches keep `low` above three quarters of d,
@@ -308,8 +328,7 @@ impl Settle<'_, '_> {
     fn settle(
         &self,
         t: f64,
-        [d, low]: [f32; 2],
-        q: [Vec3; 2],
+        ([d, low], q, overlap): ([f32; 2], [Vec3; 2], Option<Overlap>),
         frame: &Frame,
         ids: [&[u32]; 2],
         last: bool,
@@ -317,18 +336,8 @@ impl Settle<'_, '_> {
         let q = q.map(|p| frame.pose_a.transform_point(p));
         let d = d as f64;
         if d <= self.aim.tol || last {
-            let c = report(
-                self.a,
-                self.b,
-                self.swept,
-                t,
-                d,
-                q,
-                frame,
-                ids,
-                self.aim.known_at(frame),
-            );
-            return Settled::Report(c);
+            let c = report(self.a, self.b, self.swept, t, d, q, frame, ids, overlap);
+            return Settled::Report(Box::new(c));
         }
         if self.mu <= 0.0 {
             return Settled::Stuck;
@@ -353,8 +362,8 @@ fn report(
     q: [Vec3; 2],
     frame: &Frame,
     [ids_a, ids_b]: [&[u32]; 2],
-    // The overlap known at these poses.
-    known: Option<&EndOverlap>,
+    // The overlap at these poses when already known (depth and points).
+    overlap: Option<Overlap>,
 ) -> PairContact {
     let [qa, qb] = q;
     let mut contact = PairContact {
@@ -369,8 +378,8 @@ fn report(
         // Touching or interpenetrating (only possible at the start): the candidates already
         // touch, so only the depth is left to find (or is known for these poses).
         let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-        let (depth, pa, pb) = match known {
-            Some(k) => (k.depth_mm, k.points[0], k.points[1]),
+        let (depth, pa, pb) = match overlap {
+            Some((depth, [pa, pb])) => (depth, pa, pb),
             None => {
                 mesh_penetration_near(ga.near(ids_a), &frame.pose_a, gb.near(ids_b), &frame.pose_b)
             }
@@ -440,20 +449,24 @@ fn advance_over(
         let enough = if t > 0.0 { ctx.aim.tol as f32 } else { -1.0 };
         let (d, low, qa, qb) = search.least(axis, enough)?;
         axis = (qb - qa).normalize_or(axis);
-        // Touching: the depth is searched from the candidates that meet, unless it is known
-        // for these poses.
-        let touching = if d == 0.0 && ctx.aim.known_at(&frame).is_none() {
+        // Touching: the depth is searched from the candidates that meet, unless the known
+        // overlap tells it.
+        let overlap = (d == 0.0)
+            .then(|| ctx.aim.overlap_at(a, b, &frame))
+            .flatten();
+        let touching = if d == 0.0 && overlap.is_none() {
             search.touching()
         } else {
             None
         };
         let ids = touching.as_ref().map_or(ids, |[x, y]| [x, y]);
-        let (h, plain) = match ctx.settle(t, [d, low], [qa, qb], &frame, ids, round == MAX_STEPS) {
+        let found = ([d, low], [qa, qb], overlap);
+        let (h, plain) = match ctx.settle(t, found, &frame, ids, round == MAX_STEPS) {
             Settled::Report(mut c) => {
                 if t == 0.0 && ctx.aim.end {
                     c.end_overlap = end_overlap(a, b, search, ctx.aim.known);
                 }
-                return Some(c);
+                return Some(*c);
             }
             Settled::Stuck => return None,
             Settled::Step { h, plain } => (h, plain),
@@ -482,7 +495,10 @@ fn advance_over(
 ///
 /// The deepest sample of an overlap `known` before (the last step's, for a resting contact),
 /// placed at the end, reaches a depth the overlap there reaches too: the walk is told it and
-/// skips the samples that cannot be deeper (the result is the same).
+/// skips the samples that cannot be deeper (the result is the same). When that overlap kept its
+/// samples inside and the teeth moved little since, no walk is needed: only the samples that
+/// can still reach that depth are tested ([`crate::geometry::InsideSamples::rewalk`], the same
+/// depth), and the candidates that meet need not be listed either.
 fn end_overlap(
     a: &Body,
     b: &Body,
@@ -490,33 +506,71 @@ fn end_overlap(
     known: Option<&EndOverlap>,
 ) -> Option<EndOverlap> {
     let poses = [a.motion.end, b.motion.end];
-    let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    let floor = known
-        .and_then(|k| k.deepest)
-        .and_then(|(side, local)| {
-            let other = [gb, ga][side].mesh_ref();
-            sample_depth(local, &poses[side], other, &poses[1 - side])
-        })
-        .map_or(0.0, |d| d - FLOOR_SLACK_MM);
-    let (depth_mm, pa, pb, on_b) = mesh_penetration_near_from(
-        ga.near(&near_a),
-        &poses[0],
-        gb.near(&near_b),
-        &poses[1],
-        floor,
-    );
-    let side = usize::from(on_b);
-    let deepest = (depth_mm > 0.0).then(|| {
-        let sample = [pa, pb][side];
+    let floor = floor_of(a, b, poses, known);
+    let found = match rewalk_known(a, b, poses, known, floor) {
+        Some(found) => found,
+        None => {
+            let [near_a, near_b] = search.meeting_at(&frame_at(poses[0], poses[1]))?;
+            mesh_penetration_near_from(
+                ga.near(&near_a),
+                &poses[0],
+                gb.near(&near_b),
+                &poses[1],
+                floor,
+            )
+        }
+    };
+    let side = usize::from(found.on_b);
+    let deepest = (found.depth > 0.0).then(|| {
+        let sample = found.points[side];
         (side, poses[side].inverse().transform_point(sample))
+    });
+    let inside = (found.depth > 0.0).then(|| KnownInside {
+        geometry: [Arc::clone(ga), Arc::clone(gb)],
+        samples: Arc::new(found.inside),
     });
     Some(EndOverlap {
         poses,
-        depth_mm,
-        points: [pa, pb],
+        depth_mm: found.depth,
+        points: found.points,
         deepest,
+        inside,
     })
+}
+
+/// The depth that the deepest sample of the overlap `known` reaches with the teeth at `poses`,
+/// less [`FLOOR_SLACK_MM`]: one the overlap there reaches (0 when none is known).
+fn floor_of(
+    a: &Body,
+    b: &Body,
+    poses: [crate::geometry::Pose; 2],
+    known: Option<&EndOverlap>,
+) -> f32 {
+    let geometry = [&a.shape.geometry, &b.shape.geometry];
+    known
+        .and_then(|k| k.deepest)
+        .and_then(|(side, local)| {
+            let other = geometry[1 - side].mesh_ref();
+            sample_depth(local, &poses[side], other, &poses[1 - side])
+        })
+        .map_or(0.0, |d| d - FLOOR_SLACK_MM)
+}
+
+/// The meshes' overlap at `poses`, found from the samples the overlap `known` kept inside
+/// ([`crate::geometry::InsideSamples::rewalk`], told `floor`): the walk's depth, without a walk
+/// or a list of the candidates that meet. `None` when it kept none for these geometries, or the
+/// teeth moved too far since.
+fn rewalk_known(
+    a: &Body,
+    b: &Body,
+    poses: [crate::geometry::Pose; 2],
+    known: Option<&EndOverlap>,
+    floor: f32,
+) -> Option<Penetration> {
+    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+    let samples = known?.inside.as_ref()?.of(ga, gb)?;
+    samples.rewalk(ga.mesh_ref(), &poses[0], gb.mesh_ref(), &poses[1], floor)
 }
 
 /// What a known deepest sample's depth is lowered by before it bounds a new search from below

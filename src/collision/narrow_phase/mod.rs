@@ -16,6 +16,8 @@ pub mod exact;
 pub(crate) mod lanes;
 pub mod spheres;
 
+use std::sync::Arc;
+
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +25,8 @@ use super::{
     motion::Motion,
     shape::{Circle, CollisionShape},
 };
+use crate::geometry::InsideSamples;
+use crate::teeth::ToothGeometry;
 
 /// The narrow-phase algorithm.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -104,7 +108,7 @@ pub struct PairContact {
 
 /// The overlap of two teeth's meshes at the end of their motion, found by the exact query for a
 /// contact at its start.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct EndOverlap {
     /// The end poses it was found at: first tooth, second. It holds for these poses only.
     pub poses: [crate::geometry::Pose; 2],
@@ -119,6 +123,10 @@ pub struct EndOverlap {
     /// depth is one the overlap reaches, which lets the next search skip shallower samples
     /// ([`crate::geometry::mesh_penetration_near_from`]). None when nothing overlaps.
     pub deepest: Option<(usize, Vec3)>,
+    /// Every sample of each mesh found inside the other, with bounds of their depths: at a
+    /// nearby placement of the same meshes the next search measures only the samples that can
+    /// still be the deepest ([`crate::geometry::InsideSamples::rewalk`]) instead of walking.
+    pub inside: Option<KnownInside>,
 }
 
 impl EndOverlap {
@@ -127,7 +135,46 @@ impl EndOverlap {
         self.poses.swap(0, 1);
         self.points.swap(0, 1);
         self.deepest = self.deepest.map(|(side, local)| (1 - side, local));
+        self.inside = self.inside.map(|k| KnownInside {
+            geometry: [1, 0].map(|i| Arc::clone(&k.geometry[i])),
+            samples: Arc::new(k.samples.swapped()),
+        });
         self
+    }
+}
+
+/// The samples an overlap's search found inside ([`EndOverlap::inside`]), with the two teeth's
+/// geometries they were found for: they serve a later search only of the same geometries.
+#[derive(Clone)]
+pub struct KnownInside {
+    /// The first tooth's geometry, then the second's.
+    pub geometry: [Arc<ToothGeometry>; 2],
+    /// The samples (shared: an overlap is copied along with its contact).
+    pub samples: Arc<InsideSamples>,
+}
+
+impl KnownInside {
+    /// The samples, when they were found for these geometries.
+    pub fn of(&self, a: &Arc<ToothGeometry>, b: &Arc<ToothGeometry>) -> Option<&InsideSamples> {
+        (Arc::ptr_eq(&self.geometry[0], a) && Arc::ptr_eq(&self.geometry[1], b))
+            .then_some(&*self.samples)
+    }
+}
+
+impl PartialEq for KnownInside {
+    /// Found for the same geometries. The samples' bounds are a search's working state, not
+    /// part of the overlap: a search from known samples and a walk find the same overlap with
+    /// different bounds.
+    fn eq(&self, other: &Self) -> bool {
+        (self.geometry.iter().zip(&other.geometry)).all(|(x, y)| Arc::ptr_eq(x, y))
+    }
+}
+
+impl std::fmt::Debug for KnownInside {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KnownInside")
+            .field("samples", &self.samples.len())
+            .finish()
     }
 }
 

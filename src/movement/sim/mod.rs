@@ -347,7 +347,7 @@ impl Simulation {
     fn keep_overlaps(&mut self) {
         self.known = (self.last.contacts.iter())
             .filter_map(|f| {
-                let overlap = f.contact.end_overlap?;
+                let overlap = f.contact.end_overlap.clone()?;
                 let geometry = [f.a, f.b].map(|i| Arc::clone(&self.teeth[i].shape.geometry));
                 Some(((f.a, f.b), KnownOverlap { geometry, overlap }))
             })

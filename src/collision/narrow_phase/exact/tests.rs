@@ -261,7 +261,7 @@ fn end_overlap_at(vertices: u32) {
         let Some(c) = query_knowing(&body_a, &body_b, None) else {
             continue;
         };
-        let Some(e) = c.end_overlap else {
+        let Some(e) = c.end_overlap.clone() else {
             assert!(
                 c.time_of_contact > 0.0,
                 "case {case}: a contact at the start without its end"
@@ -322,7 +322,7 @@ fn end_overlap_at(vertices: u32) {
         );
         let elsewhere = EndOverlap {
             poses: [ma.start, mb.start],
-            ..e
+            ..e.clone()
         };
         assert_eq!(
             query_knowing(&body_a, &body_b, Some(&elsewhere)),
@@ -332,7 +332,7 @@ fn end_overlap_at(vertices: u32) {
         if plain.as_ref().is_some_and(|c| c.depth_mm > 0.0) {
             let doctored = EndOverlap {
                 depth_mm: e.depth_mm + 1.0,
-                ..e
+                ..e.clone()
             };
             let c = query_knowing(&body_a, &body_b, Some(&doctored)).unwrap();
             assert_eq!(c.depth_mm, doctored.depth_mm, "case {case}");
