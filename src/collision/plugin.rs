@@ -6,12 +6,17 @@
 //! [`Contacts`] resource, one [`ToothContact`] message per contact, and a [`ContactStarted`] entity
 //! event (on the first tooth of the pair) when a pair starts touching. A tooth's motion over the
 //! step is its [`ToothMotion`] (written by the movement stage), else it stands still at its
-//! `Transform`. When nothing moves the broad and narrow phases do not run.
+//! `Transform`. When nothing moves the broad and narrow phases do not run. A pair's query starts
+//! from the overlap its contact found at the end of the last step, as a simulation's steps do
+//! ([`crate::collision::query_knowing`]): a resting contact's overlap is not walked again.
 //!
 //! The systems sit in the chained [`CollisionSystems`] sets; the simulation schedule plugin (a
 //! layer above) nests each in its stage of the simulation step.
 
-use std::{collections::HashSet, sync::Arc};
+use std::{
+    collections::{HashMap, HashSet},
+    sync::Arc,
+};
 
 use bevy::{
     ecs::{intern::Interned, schedule::ScheduleLabel},
@@ -252,7 +257,12 @@ fn narrow_phase(
     mut touching: ResMut<Touching>,
     mut messages: MessageWriter<ToothContact>,
 ) {
-    contacts.list.clear();
+    // Each pair's overlap at the end of the last step, for its query this step: kept only where
+    // it holds the samples it found inside for these teeth's geometries (a tooth whose mesh
+    // changed starts afresh; see `known_for`).
+    let last: HashMap<(Entity, Entity), EndOverlap> = (contacts.list.drain(..))
+        .filter_map(|c| Some(((c.a, c.b), c.end_overlap?)))
+        .collect();
     contacts.pairs_tested = pairs.pairs.len();
     let mut now = HashSet::new();
     for &(ea, eb) in &pairs.pairs {
@@ -269,7 +279,8 @@ fn narrow_phase(
             circle: b.2.circle,
             motion: motion_of(b.3, b.4),
         };
-        let Some(hit) = query_knowing(settings.method, &body_a, &body_b, None) else {
+        let known = known_for(last.get(&(ea, eb)), &body_a, &body_b);
+        let Some(hit) = query_knowing(settings.method, &body_a, &body_b, known) else {
             continue;
         };
         let contact = Contact {
@@ -293,4 +304,12 @@ fn narrow_phase(
         contacts.list.push(contact);
     }
     touching.0 = now;
+}
+
+/// The overlap `last` found for a pair, when it was found for these bodies' geometries (it then
+/// holds the samples it found inside them; [`crate::collision::KnownInside::of`]): the next
+/// query starts from it, which saves the walk of a resting contact's overlap.
+fn known_for<'k>(last: Option<&'k EndOverlap>, a: &Body, b: &Body) -> Option<&'k EndOverlap> {
+    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
+    last.filter(|k| (k.inside.as_ref()).is_some_and(|i| i.of(ga, gb).is_some()))
 }

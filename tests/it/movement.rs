@@ -382,7 +382,13 @@ fn ipr_records_the_overlap_within_its_limit() {
 /// A headless app with `case` loaded, updated until its simulation has started (every tooth has
 /// its tree), or for about 15 s.
 fn simulating_app(case: &str) -> App {
+    simulating_app_with(case, Method::Continuous)
+}
+
+/// [`simulating_app`] with the narrow phase `method`.
+fn simulating_app_with(case: &str, method: Method) -> App {
     let mut app = create_app();
+    app.insert_resource(orthosim::collision::CollisionSettings { method });
     app.world_mut().write_message(LoadCase(case.into()));
     for _ in 0..3000 {
         app.update();
@@ -396,8 +402,20 @@ fn simulating_app(case: &str) -> App {
 
 #[test]
 fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
+    plugin_moves_teeth_as_the_simulation(Method::Continuous);
+}
+
+/// The same with exact contact, where each pair's query starts from the overlap its contact
+/// found at the end of the step before (in the plugin as in the simulation).
+#[test]
+fn with_exact_contact_the_movement_plugin_moves_teeth_as_the_simulation_does() {
+    plugin_moves_teeth_as_the_simulation(Method::Exact);
+}
+
+/// 150 steps of case 1 with `method`, in the plugins and in the engine-free simulation.
+fn plugin_moves_teeth_as_the_simulation(method: Method) {
     // The case with its (octree, the plugin's default) trees.
-    let mut app = simulating_app("case1");
+    let mut app = simulating_app_with("case1", method);
     let start = app.world().resource::<MovementStatus>().steps;
     assert!(app.world().resource::<SimulationState>().sim.is_some());
     for _ in 0..150 {
@@ -407,8 +425,7 @@ fn the_movement_plugin_moves_teeth_as_the_engine_free_simulation_does() {
     // The same steps without the ECS.
     let d = Dentition::build(Case::resolve("case1").unwrap()).unwrap();
     let shapes = collision_shapes(&d, TreeSettings::default(), None).unwrap();
-    let mut sim =
-        Simulation::new(&d, shapes, Method::Continuous, MovementSettings::default()).unwrap();
+    let mut sim = Simulation::new(&d, shapes, method, MovementSettings::default()).unwrap();
     for _ in 0..start + 150 {
         sim.step();
     }

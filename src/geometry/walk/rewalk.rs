@@ -112,6 +112,12 @@ impl InsideSamples {
         self.sides.iter().map(|s| s.samples.len()).sum()
     }
 
+    /// How deep (mm) a sample not listed may have got since the samples were found by a walk:
+    /// 0 right after a walk, growing by the teeth's relative move at each search from them.
+    pub fn rest_mm(&self) -> f64 {
+        self.sides[0].rest.max(self.sides[1].rest)
+    }
+
     /// Whether no sample is listed.
     pub fn is_empty(&self) -> bool {
         self.len() == 0

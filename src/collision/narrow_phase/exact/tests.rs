@@ -237,6 +237,7 @@ fn end_overlap_at(vertices: u32) {
     let towards = (b.1.translation - a.1.translation).normalize();
     let mut rng = Rng(0x0e0d_0f57);
     let (mut carried, mut apart, mut deeper, mut known, mut floored) = (0, 0, 0, 0, 0);
+    let mut again = 0;
     for case in 0..40 {
         let start = Pose::new(
             a.1.rotation,
@@ -315,11 +316,11 @@ fn end_overlap_at(vertices: u32) {
             }),
             "case {case}"
         );
-        assert_eq!(
-            query_knowing(&body_a, &body_b, Some(&e)),
-            plain,
-            "case {case}"
-        );
+        let knowing = query_knowing(&body_a, &body_b, Some(&e));
+        assert_eq!(knowing, plain, "case {case}");
+        // Found from the samples the last overlap kept inside, not walked.
+        let inside = knowing.and_then(|c| c.end_overlap?.inside);
+        again += inside.is_some_and(|k| k.samples.rest_mm() > 0.0) as usize;
         let elsewhere = EndOverlap {
             poses: [ma.start, mb.start],
             ..e.clone()
@@ -340,8 +341,9 @@ fn end_overlap_at(vertices: u32) {
         }
     }
     eprintln!(
-        "{vertices} vertices: {carried} carried, {apart} end apart, {deeper} deepen, {known} known, {floored} with a deepest sample"
+        "{vertices} vertices: {carried} carried, {apart} end apart, {deeper} deepen, {known} known, {floored} with a deepest sample, {again} found again"
     );
+    assert!(again > 5, "{again} found from the samples kept");
     assert!(carried > 25 && apart > 2 && deeper > 5 && carried - deeper > 5 && known > 10);
     assert!(floored > 10);
 }
