@@ -54,7 +54,11 @@
 //! response needs to tell whether the contact deepens: every
 //! triangle pair that meets at the end touches during the motion, so it is a candidate pair, and
 //! the walk goes from the candidates that meet at the end placement instead of the whole meshes'
-//! meeting triangles, which cost a search of both meshes' hierarchies. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
+//! meeting triangles, which cost a search of both meshes' hierarchies. A known overlap that kept
+//! the samples it found inside ([`EndOverlap::inside`]) spares the walk at a nearby placement of
+//! the same meshes, at the start or the end of the motion: only the samples that can still be the
+//! deepest are tested ([`crate::geometry::InsideSamples::rewalk`]; the same depth), and the
+//! candidates that meet are not listed. After [`MAX_STEPS`] steps (slow convergence under large rotations) the current, still
 //! conservative, time is reported with its gap.
 //!
 //! Two ways to search the candidates, the same pairs and the same guarantees. **Flat**
@@ -83,11 +87,11 @@
 //!
 //! [`Motion::speed_bound_of`]: crate::collision::motion::Motion::speed_bound_of
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use super::lanes::Affine32;
-use std::sync::Arc;
-
 use super::{Body, EndOverlap, KnownInside, PairContact, continuous};
 use crate::collision::motion::{DPose, Motion};
 use crate::geometry::{
@@ -376,7 +380,7 @@ fn report(
     };
     if d == 0.0 {
         // Touching or interpenetrating (only possible at the start): the candidates already
-        // touch, so only the depth is left to find (or is known for these poses).
+        // touch, so only the depth is left to find (or the known overlap tells it).
         let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
         let (depth, pa, pb) = match overlap {
             Some((depth, [pa, pb])) => (depth, pa, pb),

@@ -233,6 +233,29 @@ mod tests {
         mesh_penetration_near_from(a.near(&near_a), pose_a, b.near(&near_b), pose_b, floor)
     }
 
+    /// The search from known samples when it answered (it must find the walk's overlap), else
+    /// the walk; `counts` counts each (found again, walked).
+    fn next(
+        again: Option<Penetration>,
+        walked: Penetration,
+        counts: &mut [u32; 2],
+        step: usize,
+    ) -> Penetration {
+        match again {
+            Some(again) => {
+                let found = (again.depth, again.points, again.on_b);
+                let walk = (walked.depth, walked.points, walked.on_b);
+                assert_eq!(found, walk, "step {step}");
+                counts[0] += 1;
+                again
+            }
+            None => {
+                counts[1] += 1;
+                walked
+            }
+        }
+    }
+
     /// The depth the deepest sample of `p` reaches at new poses, less a margin (as the exact
     /// query's floor).
     fn floor_of([a, b]: [&ToothGeometry; 2], p: &Penetration, poses: [&Pose; 2]) -> f32 {
@@ -266,7 +289,7 @@ mod tests {
         let mut known = walk(teeth, &pose_a, &base, 0.0);
         assert!(known.depth > 0.2, "{}", known.depth);
         let mut pose_b = base;
-        let (mut rewalked, mut declined, mut turned) = (0, 0, 0.0f32);
+        let (mut counts, mut turned) = ([0; 2], 0.0f32);
         for step in 0..60 {
             let last = pose_b;
             pose_b = match step {
@@ -310,29 +333,14 @@ mod tests {
                 );
             }
 
-            match known
+            let again = known
                 .inside
-                .rewalk(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b, floor)
-            {
-                Some(again) => {
-                    let found = (again.depth, again.points, again.on_b);
-                    assert_eq!(
-                        found,
-                        (walked.depth, walked.points, walked.on_b),
-                        "step {step}"
-                    );
-                    rewalked += 1;
-                    known = again;
-                }
-                None => {
-                    declined += 1;
-                    known = walked;
-                }
-            }
+                .rewalk(a.mesh_ref(), &pose_a, b.mesh_ref(), &pose_b, floor);
+            known = next(again, walked, &mut counts, step);
         }
         assert!(
-            rewalked >= 40 && declined >= 3,
-            "{rewalked} again, {declined} walked"
+            counts[0] >= 40 && counts[1] >= 3,
+            "{counts:?} (found again, walked)"
         );
         assert!(turned > 2e-3, "largest turn {turned} rad");
         for floor in [0.0, -1.0, f32::NAN] {
@@ -378,7 +386,7 @@ mod tests {
         };
         let mut known = walk(&tipped(0), 0.0);
         assert!((known.depth - 0.2).abs() < 1e-4, "{}", known.depth);
-        let (mut rewalked, mut declined) = (0, 0);
+        let mut counts = [0; 2];
         for step in 1..=40 {
             let pose_b = tipped(step);
             let side = usize::from(known.on_b);
@@ -389,22 +397,8 @@ mod tests {
             let floor = sample_depth(local, &poses[side], [b, a][side], &poses[1 - side])
                 .map_or(0.0, |d| d - 1e-4);
             let walked = walk(&pose_b, floor);
-            match known.inside.rewalk(a, &Pose::IDENTITY, b, &pose_b, floor) {
-                Some(again) => {
-                    let found = (again.depth, again.points, again.on_b);
-                    assert_eq!(
-                        found,
-                        (walked.depth, walked.points, walked.on_b),
-                        "step {step}"
-                    );
-                    rewalked += 1;
-                    known = again;
-                }
-                None => {
-                    declined += 1;
-                    known = walked;
-                }
-            }
+            let again = known.inside.rewalk(a, &Pose::IDENTITY, b, &pose_b, floor);
+            known = next(again, walked, &mut counts, step);
         }
         // The far end sank 0.48 mm from 0.1 mm above the block: now 0.38 mm deep.
         let far = tipped(40).transform_point(Vec3::new(6.0, 0.0, 0.0));
@@ -413,8 +407,8 @@ mod tests {
             "{known:?} (far end {far})"
         );
         assert!(
-            rewalked >= 20 && declined >= 1,
-            "{rewalked} again, {declined} walked"
+            counts[0] >= 20 && counts[1] >= 1,
+            "{counts:?} (found again, walked)"
         );
     }
 }
