@@ -257,9 +257,8 @@ fn narrow_phase(
     mut touching: ResMut<Touching>,
     mut messages: MessageWriter<ToothContact>,
 ) {
-    // Each pair's overlap at the end of the last step, for its query this step: kept only where
-    // it holds the samples it found inside for these teeth's geometries (a tooth whose mesh
-    // changed starts afresh; see `known_for`).
+    // Each pair's overlap at the end of the last step, for its query this step (which ignores
+    // it if a tooth's mesh changed since).
     let last: HashMap<(Entity, Entity), EndOverlap> = (contacts.list.drain(..))
         .filter_map(|c| Some(((c.a, c.b), c.end_overlap?)))
         .collect();
@@ -279,7 +278,7 @@ fn narrow_phase(
             circle: b.2.circle,
             motion: motion_of(b.3, b.4),
         };
-        let known = known_for(last.get(&(ea, eb)), &body_a, &body_b);
+        let known = last.get(&(ea, eb));
         let Some(hit) = query_knowing(settings.method, &body_a, &body_b, known) else {
             continue;
         };
@@ -304,12 +303,4 @@ fn narrow_phase(
         contacts.list.push(contact);
     }
     touching.0 = now;
-}
-
-/// The overlap `last` found for a pair, when it was found for these bodies' geometries (it then
-/// holds the samples it found inside them; [`crate::collision::KnownInside::of`]): the next
-/// query starts from it, which saves the walk of a resting contact's overlap.
-fn known_for<'k>(last: Option<&'k EndOverlap>, a: &Body, b: &Body) -> Option<&'k EndOverlap> {
-    let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    last.filter(|k| (k.inside.as_ref()).is_some_and(|i| i.of(ga, gb).is_some()))
 }

@@ -186,8 +186,11 @@ pub fn query_with(a: &Body, b: &Body, tolerance: f32) -> Option<PairContact> {
 /// leaves it out, as it costs a walk), and the overlap at the start poses may already be
 /// `known`: the overlap a contact carried from the end of the step before, used when its poses
 /// are the start poses (the same depth and points the search would find, without walking the
-/// meshes again); otherwise ignored.
+/// meshes again), and its samples inside at other nearby poses (the same depth, without a walk);
+/// ignored when it was found for other geometries than these bodies'.
 pub fn query_knowing(a: &Body, b: &Body, known: Option<&EndOverlap>) -> Option<PairContact> {
+    // Only an overlap of these meshes.
+    let known = known.filter(|k| k.is_for(&a.shape.geometry, &b.shape.geometry));
     let aim = Aim {
         tol: GAP_TOLERANCE_MM as f64,
         known,
@@ -530,10 +533,10 @@ fn end_overlap(
         let sample = found.points[side];
         (side, poses[side].inverse().transform_point(sample))
     });
-    let inside = (found.depth > 0.0).then(|| KnownInside {
+    let inside = KnownInside {
         geometry: [Arc::clone(ga), Arc::clone(gb)],
-        samples: Arc::new(found.inside),
-    });
+        samples: (found.depth > 0.0).then(|| Arc::new(found.inside)),
+    };
     Some(EndOverlap {
         poses,
         depth_mm: found.depth,
@@ -563,8 +566,8 @@ fn floor_of(
 
 /// The meshes' overlap at `poses`, found from the samples the overlap `known` kept inside
 /// ([`crate::geometry::InsideSamples::rewalk`], told `floor`): the walk's depth, without a walk
-/// or a list of the candidates that meet. `None` when it kept none for these geometries, or the
-/// teeth moved too far since.
+/// or a list of the candidates that meet. `None` when it kept none, or the teeth moved too far
+/// since. (Known overlaps are of these meshes: [`query_knowing`] drops any other.)
 fn rewalk_known(
     a: &Body,
     b: &Body,
@@ -573,7 +576,7 @@ fn rewalk_known(
     floor: f32,
 ) -> Option<Penetration> {
     let (ga, gb) = (&a.shape.geometry, &b.shape.geometry);
-    let samples = known?.inside.as_ref()?.of(ga, gb)?;
+    let samples = known?.inside.samples.as_ref()?;
     samples.rewalk(ga.mesh_ref(), &poses[0], gb.mesh_ref(), &poses[1], floor)
 }
 

@@ -123,10 +123,11 @@ pub struct EndOverlap {
     /// depth is one the overlap reaches, which lets the next search skip shallower samples
     /// ([`crate::geometry::mesh_penetration_near_from`]). None when nothing overlaps.
     pub deepest: Option<(usize, Vec3)>,
-    /// Every sample of each mesh found inside the other, with bounds of their depths: at a
-    /// nearby placement of the same meshes the next search measures only the samples that can
-    /// still be the deepest ([`crate::geometry::InsideSamples::rewalk`]) instead of walking.
-    pub inside: Option<KnownInside>,
+    /// The two teeth's geometries it was found for, and every sample of each mesh found inside
+    /// the other with bounds of their depths: a query uses the overlap only for the same
+    /// geometries, and at a nearby placement of them measures only the samples that can still
+    /// be the deepest ([`crate::geometry::InsideSamples::rewalk`]) instead of walking.
+    pub inside: KnownInside,
 }
 
 impl EndOverlap {
@@ -135,30 +136,31 @@ impl EndOverlap {
         self.poses.swap(0, 1);
         self.points.swap(0, 1);
         self.deepest = self.deepest.map(|(side, local)| (1 - side, local));
-        self.inside = self.inside.map(|k| KnownInside {
-            geometry: [1, 0].map(|i| Arc::clone(&k.geometry[i])),
-            samples: Arc::new(k.samples.swapped()),
-        });
+        let [a, b] = self.inside.geometry;
+        self.inside = KnownInside {
+            geometry: [b, a],
+            samples: (self.inside.samples).map(|s| Arc::new(s.swapped())),
+        };
         self
+    }
+
+    /// Whether it was found for these two geometries (first tooth's, second's).
+    pub fn is_for(&self, a: &Arc<ToothGeometry>, b: &Arc<ToothGeometry>) -> bool {
+        let [ga, gb] = &self.inside.geometry;
+        Arc::ptr_eq(ga, a) && Arc::ptr_eq(gb, b)
     }
 }
 
-/// The samples an overlap's search found inside ([`EndOverlap::inside`]), with the two teeth's
-/// geometries they were found for: they serve a later search only of the same geometries.
+/// What an overlap was found for ([`EndOverlap::inside`]): the two teeth's geometries (kept
+/// alive, so a tooth given another mesh is never taken for the same one) and the samples found
+/// inside, when the meshes overlap.
 #[derive(Clone)]
 pub struct KnownInside {
     /// The first tooth's geometry, then the second's.
     pub geometry: [Arc<ToothGeometry>; 2],
-    /// The samples (shared: an overlap is copied along with its contact).
-    pub samples: Arc<InsideSamples>,
-}
-
-impl KnownInside {
-    /// The samples, when they were found for these geometries.
-    pub fn of(&self, a: &Arc<ToothGeometry>, b: &Arc<ToothGeometry>) -> Option<&InsideSamples> {
-        (Arc::ptr_eq(&self.geometry[0], a) && Arc::ptr_eq(&self.geometry[1], b))
-            .then_some(&*self.samples)
-    }
+    /// The samples (shared: an overlap is copied along with its contact); `None` when nothing
+    /// overlaps.
+    pub samples: Option<Arc<InsideSamples>>,
 }
 
 impl PartialEq for KnownInside {
@@ -173,7 +175,7 @@ impl PartialEq for KnownInside {
 impl std::fmt::Debug for KnownInside {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("KnownInside")
-            .field("samples", &self.samples.len())
+            .field("samples", &self.samples.as_ref().map(|s| s.len()))
             .finish()
     }
 }

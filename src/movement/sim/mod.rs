@@ -49,7 +49,6 @@
 
 use std::{
     collections::{BTreeMap, BTreeSet},
-    sync::Arc,
     time::Instant,
 };
 
@@ -76,7 +75,7 @@ use crate::{
         Body, Circle, CollisionShape, EndOverlap, Method, Motion, PairContact, query_knowing,
     },
     geometry::{Pose, mesh_separation},
-    teeth::{Arch, Fdi, Load, ToothGeometry, WireModel, arch::ArchCurve},
+    teeth::{Arch, Fdi, Load, WireModel, arch::ArchCurve},
 };
 
 /// Rounds of cutting steps at contact times before blocked teeth are stopped outright.
@@ -255,15 +254,8 @@ pub struct Simulation {
     pub elapsed_days: f64,
     /// The overlaps found at the end of the last step for its contacts that touched at their
     /// start (exact method), by tooth pair: the next step's queries start from them.
-    known: BTreeMap<(usize, usize), KnownOverlap>,
-}
-
-/// An overlap at the end of a step ([`EndOverlap`]) with the geometries it was found for (kept
-/// alive, so a tooth given another mesh is never taken for the same one).
-#[derive(Clone, Debug)]
-struct KnownOverlap {
-    geometry: [Arc<ToothGeometry>; 2],
-    overlap: EndOverlap,
+    /// (Each holds the geometries it was found for; a query ignores one of other meshes.)
+    known: BTreeMap<(usize, usize), EndOverlap>,
 }
 
 fn row(arch: Arch) -> usize {
@@ -325,18 +317,13 @@ impl Simulation {
     }
 
     /// The narrow phase on `pairs` with the current motions, each pair starting from the
-    /// overlap its contact carried at the end of the last step (used only where its poses and
-    /// meshes are this step's start).
+    /// overlap its contact carried at the end of the last step (which the query uses only for
+    /// the same meshes).
     pub fn narrow(&self, pairs: &[(usize, usize)]) -> Vec<Found> {
         pairs
             .iter()
             .filter_map(|&(a, b)| {
-                let (ta, tb) = (&self.teeth[a].shape.geometry, &self.teeth[b].shape.geometry);
-                let known = self
-                    .known
-                    .get(&(a, b))
-                    .filter(|k| Arc::ptr_eq(&k.geometry[0], ta) && Arc::ptr_eq(&k.geometry[1], tb));
-                let known = known.map(|k| &k.overlap);
+                let known = self.known.get(&(a, b));
                 query_knowing(self.method, &self.body(a), &self.body(b), known)
                     .map(|contact| Found { a, b, contact })
             })
@@ -346,11 +333,7 @@ impl Simulation {
     /// Keeps the overlaps the last step's contacts carried, for the next step's queries.
     fn keep_overlaps(&mut self) {
         self.known = (self.last.contacts.iter())
-            .filter_map(|f| {
-                let overlap = f.contact.end_overlap.clone()?;
-                let geometry = [f.a, f.b].map(|i| Arc::clone(&self.teeth[i].shape.geometry));
-                Some(((f.a, f.b), KnownOverlap { geometry, overlap }))
-            })
+            .filter_map(|f| Some(((f.a, f.b), f.contact.end_overlap.clone()?)))
             .collect();
     }
 

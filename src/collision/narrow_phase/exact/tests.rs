@@ -319,8 +319,8 @@ fn end_overlap_at(vertices: u32) {
         let knowing = query_knowing(&body_a, &body_b, Some(&e));
         assert_eq!(knowing, plain, "case {case}");
         // Found from the samples the last overlap kept inside, not walked.
-        let inside = knowing.and_then(|c| c.end_overlap?.inside);
-        again += inside.is_some_and(|k| k.samples.rest_mm() > 0.0) as usize;
+        let inside = knowing.and_then(|c| c.end_overlap?.inside.samples);
+        again += inside.is_some_and(|s| s.rest_mm() > 0.0) as usize;
         let elsewhere = EndOverlap {
             poses: [ma.start, mb.start],
             ..e.clone()
@@ -338,6 +338,17 @@ fn end_overlap_at(vertices: u32) {
             let c = query_knowing(&body_a, &body_b, Some(&doctored)).unwrap();
             assert_eq!(c.depth_mm, doctored.depth_mm, "case {case}");
             known += 1;
+            // The same overlap said to be of other meshes is ignored.
+            let [ga, gb] = doctored.inside.geometry.clone();
+            let of_others = EndOverlap {
+                inside: crate::collision::KnownInside {
+                    geometry: [gb, ga],
+                    samples: None,
+                },
+                ..doctored
+            };
+            let c = query_knowing(&body_a, &body_b, Some(&of_others));
+            assert_eq!(c, plain, "case {case}");
         }
     }
     eprintln!(
