@@ -74,6 +74,9 @@ pub struct InspectReport {
     pub imported: Vec<ImportedMesh>,
     /// Where the case's mesh and scan files were placed (empty without them).
     pub orientation: Vec<crate::teeth::OrientationReport>,
+    /// What the import of each labelled scan changed in its labels or left out (empty without
+    /// scans).
+    pub scans: Vec<crate::teeth::ScanReport>,
 }
 
 /// A tooth read from a mesh file.
@@ -182,6 +185,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
             })
             .collect(),
         orientation: d.orientation.clone(),
+        scans: d.scans.clone(),
     }
 }
 

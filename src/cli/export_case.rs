@@ -6,8 +6,8 @@ use anyhow::Result;
 use clap::Args;
 use orthosim::teeth::{
     Case, Dentition,
-    import::{ExportMeshes, export_case_as, export_labelled_scans},
-    labelled_scan::ScanFormat,
+    import::{ExportMeshes, export_case_as, export_labelled_scans_with},
+    labelled_scan::{LabelFaults, ScanFormat},
 };
 
 /// `export-case`'s arguments.
@@ -30,6 +30,11 @@ pub struct ExportCaseArgs {
     /// label file). The case names them in `scans` without a transform.
     #[arg(long, value_enum, requires = "scan_like")]
     pub labelled: Option<LabelledFormat>,
+    /// With `--labelled`: labels that fail as real segmentations' do: labels run into the gum,
+    /// fragments of a tooth's label on its neighbour, islands on the gum, and central incisors
+    /// whose surface crosses itself (see `inspect` for what the import makes of them).
+    #[arg(long, requires = "labelled")]
+    pub faults: bool,
     /// Seed of the scan-like defects (and of the scanner frame with `--labelled`).
     #[arg(long, default_value_t = 1, requires = "scan_like")]
     pub seed: u64,
@@ -55,8 +60,19 @@ pub fn run(args: ExportCaseArgs) -> Result<()> {
             LabelledFormat::Colours => ScanFormat::PlyColours,
             LabelledFormat::Obj => ScanFormat::ObjJson,
         };
-        let (report, frame) =
-            export_labelled_scans(&d, &args.out, triangles as usize, args.seed, format)?;
+        let faults = if args.faults {
+            LabelFaults::REAL
+        } else {
+            LabelFaults::NONE
+        };
+        let (report, frame) = export_labelled_scans_with(
+            &d,
+            &args.out,
+            triangles as usize,
+            args.seed,
+            format,
+            &faults,
+        )?;
         let (r, t) = orthosim::teeth::import::orient::as_euler_deg(&frame.pose.inverse());
         println!(
             "wrote {} ({} scans, {} triangles, {:?}); the scans' true placement: rotation_deg ({:.2}, {:.2}, {:.2}), translation ({:.2}, {:.2}, {:.2}) mm",

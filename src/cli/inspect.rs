@@ -97,6 +97,27 @@ fn print_table(report: &InspectReport) {
             println!("  {}: {}", m.fdi, m.summary);
         }
     }
+    for scan in &report.scans {
+        if scan.fixes.is_empty() && scan.left_out.is_empty() {
+            continue;
+        }
+        println!("labels of {}:", scan.file);
+        for f in &scan.fixes {
+            let [x, y, z] = f.at;
+            let to = match (f.action, f.to) {
+                ("trimmed", _) => "past the crown".to_owned(),
+                (_, 0) => "to the gum".to_owned(),
+                (_, n) => format!("to {n}"),
+            };
+            println!(
+                "  {} {}: {} triangles {to}, near ({x:.2}, {y:.2}, {z:.2}) mm",
+                f.action, f.label, f.triangles
+            );
+        }
+        for l in &scan.left_out {
+            println!("  left out {}: {}", l.fdi, l.reason);
+        }
+    }
     println!("neighbour gaps (mm):");
     for g in &report.neighbour_gaps_mm {
         println!("  {}-{}: {:.3}", g.a, g.b, g.gap_mm);

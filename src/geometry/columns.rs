@@ -215,6 +215,15 @@ impl Columns {
         (self.lo0, self.hi0, self.lo1, self.hi1) = (lo0, hi0, lo1, hi1);
     }
 
+    /// The inside intervals (sorted, disjoint) along lattice line (i, j): `i` counts along axis
+    /// (axis+1)%3, `j` along (axis+2)%3; empty beyond the lattice.
+    pub fn spans(&self, i: usize, j: usize) -> &[[f32; 2]] {
+        if i >= self.dims[0] || j >= self.dims[1] {
+            return &[];
+        }
+        self.spans_of(i * self.dims[1] + j)
+    }
+
     /// The intervals of a line.
     fn spans_of(&self, line: usize) -> &[[f32; 2]] {
         &self.spans[self.offsets[line] as usize..self.offsets[line + 1] as usize]

@@ -11,6 +11,7 @@ pub(crate) mod columns;
 mod crossing;
 pub(crate) mod decimate;
 pub(crate) mod interval;
+pub mod isosurface;
 pub(crate) mod lanes;
 mod mass;
 mod mat6;

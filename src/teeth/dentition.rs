@@ -102,6 +102,8 @@ pub struct Dentition {
     pub imported: std::collections::BTreeMap<Fdi, Repairs>,
     /// Where the case's mesh and scan files were placed.
     pub orientation: Vec<OrientationReport>,
+    /// What the import of each labelled scan changed in its labels or left out.
+    pub scans: Vec<super::patient::ScanReport>,
 }
 
 impl Dentition {
@@ -135,6 +137,7 @@ impl Dentition {
         let mut arch_forms = [arrangement.upper, ArchLayout::default().lower];
         let mut imported_repairs = std::collections::BTreeMap::new();
         let mut orientation = Vec::new();
+        let mut scans = Vec::new();
         if let Some(patient) = patient {
             // Each imported tooth's buccal axis comes from the arch as it is: the arrangement's
             // forms fitted to the cervical centres of the teeth present. An imported tooth's
@@ -160,6 +163,7 @@ impl Dentition {
                 imported_repairs.insert(*f, tooth.repairs);
             }
             orientation = patient.orientation;
+            scans = patient.scans;
         }
         let lift = Vec3::Y * case.bite_opening_mm.0;
         for tooth in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Upper) {
@@ -216,6 +220,7 @@ impl Dentition {
             arch_forms,
             imported: imported_repairs,
             orientation,
+            scans,
         })
     }
 

@@ -83,9 +83,56 @@ pub const GUM_COLOUR: (u8, u8, u8) = (230, 150, 160);
 /// The labelled arch of `d`'s visible teeth of `arch` in orthosim's frame: scan-like crowns of
 /// about `triangles` triangles each, with typical defects drawn from `seed`, and a gum band.
 pub fn labelled_arch(d: &Dentition, arch: Arch, triangles: usize, seed: u64) -> LabelledArch {
-    let mut mesh = TriMesh::default();
-    let mut labels = Vec::new();
+    labelled_arch_with(d, arch, triangles, seed, &LabelFaults::NONE)
+}
+
+/// How a generated labelled arch fails the way real segmentations do.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LabelFaults {
+    /// Crowns whose label runs into the gum: a flap of gum 1.5–3 mm apical and 2.5–5 mm outward
+    /// of the margin carries the tooth's label, joined to the crown along its margin, with a
+    /// strip of gum-labelled surface beyond it.
+    pub gum_bleed: usize,
+    /// Neighbouring pairs where the label of one tooth covers a fragment of the other's crown
+    /// near their contact.
+    pub fragments: usize,
+    /// Islands: a few gum triangles labelled with a nearby tooth.
+    pub islands: usize,
+    /// Thin incisors (then other teeth, lower arch first in a lower scan) whose incisal half is
+    /// turned through the rest of the crown, so the surface crosses itself more than the repair
+    /// can usually cut out.
+    pub crossed: usize,
+}
+
+impl LabelFaults {
+    /// Labels as a perfect segmentation gives them.
+    pub const NONE: Self = Self {
+        gum_bleed: 0,
+        fragments: 0,
+        islands: 0,
+        crossed: 0,
+    };
+
+    /// Every failure mode of real labelled scans, a few times each.
+    pub const REAL: Self = Self {
+        gum_bleed: 3,
+        fragments: 3,
+        islands: 3,
+        crossed: 2,
+    };
+}
+
+/// [`labelled_arch`] with the label `faults` of real segmentations, drawn from `seed`.
+pub fn labelled_arch_with(
+    d: &Dentition,
+    arch: Arch,
+    triangles: usize,
+    seed: u64,
+    faults: &LabelFaults,
+) -> LabelledArch {
+    let mut rng = Rng(seed.wrapping_mul(0xA24B_AED4_963E_E407) | 1);
     let teeth: Vec<_> = d.visible().filter(|t| t.fdi.arch() == arch).collect();
+    let mut crowns: Vec<(u32, TriMesh, Vec<u32>)> = Vec::new();
     for t in &teeth {
         let s = seed
             .wrapping_mul(100)
@@ -98,24 +145,188 @@ pub fn labelled_arch(d: &Dentition, arch: Arch, triangles: usize, seed: u64) -> 
             &ScanDefects::typical(s),
             s,
         );
-        append(
-            &mut mesh,
-            &mut labels,
-            &crown.mesh,
-            u32::from(t.fdi.number()),
-        );
+        let n = u32::from(t.fdi.number());
+        let labels = vec![n; crown.mesh.vertices.len()];
+        crowns.push((n, crown.mesh, labels));
+    }
+    // Incisors first: the thinnest crowns cross themselves most readily.
+    let mut order: Vec<usize> = (0..teeth.len()).collect();
+    order.sort_by_key(|&i| (teeth[i].fdi.kind() as u8, teeth[i].fdi.number()));
+    for &i in order.iter().take(faults.crossed) {
+        let pose = teeth[i].pose;
+        cross_incisal_part(&mut crowns[i].1, &pose);
+    }
+    for _ in 0..faults.gum_bleed.min(teeth.len()) {
+        let i = (rng.uniform() * teeth.len() as f32) as usize % teeth.len();
+        let flare = 2.5 + 2.5 * rng.uniform();
+        let drop = 1.5 + 1.5 * rng.uniform();
+        let (_, mesh, labels) = &mut crowns[i];
+        bleed_into_gum(mesh, labels, &teeth[i].pose, drop, flare);
+    }
+    for _ in 0..faults.fragments.min(teeth.len().saturating_sub(1)) {
+        let i = (rng.uniform() * (teeth.len() - 1) as f32) as usize % (teeth.len() - 1);
+        // The pair next to each other along the arch.
+        let mut by_place: Vec<usize> = (0..teeth.len()).collect();
+        by_place.sort_by_key(|&k| teeth[k].fdi.arch_index());
+        let (a, b) = (by_place[i], by_place[i + 1]);
+        let (a, b) = if rng.uniform() < 0.5 { (a, b) } else { (b, a) };
+        let label = crowns[a].0;
+        let near = vertices_near(&crowns[b].1, &crowns[a].1, 0.8);
+        for v in near {
+            crowns[b].2[v] = label;
+        }
+    }
+    let mut mesh = TriMesh::default();
+    let mut labels = Vec::new();
+    for (_, crown, crown_labels) in &crowns {
+        append(&mut mesh, &mut labels, crown, crown_labels);
     }
     let gum = gum_band(&teeth.iter().map(|t| t.pose).collect::<Vec<_>>(), arch);
-    append(&mut mesh, &mut labels, &gum, 0);
+    let start = mesh.vertices.len();
+    append(&mut mesh, &mut labels, &gum, &vec![0; gum.vertices.len()]);
+    for _ in 0..faults.islands {
+        if gum.triangles.is_empty() {
+            break;
+        }
+        // Two corners of a gum triangle take the nearest tooth's label: a few triangles.
+        let t = gum.triangles
+            [(rng.uniform() * gum.triangles.len() as f32) as usize % gum.triangles.len()];
+        let at = gum.vertices[t[0] as usize];
+        let nearest = teeth
+            .iter()
+            .min_by(|p, q| {
+                p.pose
+                    .translation
+                    .distance(at)
+                    .total_cmp(&q.pose.translation.distance(at))
+            })
+            .map_or(0, |p| u32::from(p.fdi.number()));
+        labels[start + t[0] as usize] = nearest;
+        labels[start + t[1] as usize] = nearest;
+    }
     LabelledArch { arch, mesh, labels }
 }
 
-fn append(mesh: &mut TriMesh, labels: &mut Vec<u32>, part: &TriMesh, label: u32) {
+/// Turns the incisal half of a crown placed by `pose` a quarter about its buccal axis through
+/// the crown's middle, so the two halves cross along the whole crown.
+fn cross_incisal_part(mesh: &mut TriMesh, pose: &Pose) {
+    let inverse = pose.inverse();
+    let local = mesh.map_vertices(|v| inverse.transform_point(v));
+    let c = local.aabb().centre();
+    let turn = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    for (v, l) in mesh.vertices.iter_mut().zip(&local.vertices) {
+        if l.y > c.y {
+            *v = pose.transform_point(c + turn * (*l - c));
+        }
+    }
+}
+
+/// Joins a flap to the crown's margin (its longest opening): a ring `drop` mm apical and `flare`
+/// mm outward labelled with the tooth, then a ring beyond it labelled gum.
+fn bleed_into_gum(mesh: &mut TriMesh, labels: &mut Vec<u32>, pose: &Pose, drop: f32, flare: f32) {
+    let Some(margin) = longest_opening(mesh) else {
+        return;
+    };
+    let apical = pose.rotation * Vec3::NEG_Y;
+    let axis = pose.translation;
+    let label = labels.first().copied().unwrap_or(0);
+    let out_of = |p: Vec3| {
+        let d = p - axis;
+        (d - apical * d.dot(apical)).normalize_or(Vec3::X)
+    };
+    let ring =
+        |mesh: &mut TriMesh, labels: &mut Vec<u32>, from: &[u32], down: f32, out: f32, l: u32| {
+            let base = mesh.vertices.len() as u32;
+            for &v in from {
+                let p = mesh.vertices[v as usize];
+                mesh.vertices.push(p + apical * down + out_of(p) * out);
+                labels.push(l);
+            }
+            (0..from.len() as u32)
+                .map(|k| base + k)
+                .collect::<Vec<u32>>()
+        };
+    let first = ring(mesh, labels, &margin, drop, flare, label);
+    let second = ring(mesh, labels, &first, 1.5, 1.5, 0);
+    // The margin runs in its triangles' direction (a → b); the flap runs it the other way.
+    for (upper, lower) in [(&margin, &first), (&first, &second)] {
+        let n = upper.len();
+        for k in 0..n {
+            let (a, b) = (upper[k], upper[(k + 1) % n]);
+            let (a1, b1) = (lower[k], lower[(k + 1) % n]);
+            mesh.triangles.push([b, a, a1]);
+            mesh.triangles.push([b, a1, b1]);
+        }
+    }
+}
+
+/// The longest loop of open edges, in its triangles' direction.
+fn longest_opening(mesh: &TriMesh) -> Option<Vec<u32>> {
+    use std::collections::{HashMap, HashSet};
+    let mut used: HashSet<(u32, u32)> = HashSet::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            used.insert((t[k], t[(k + 1) % 3]));
+        }
+    }
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    for &(a, b) in &used {
+        if !used.contains(&(b, a)) {
+            next.entry(a).or_insert(b);
+        }
+    }
+    let mut seen: HashSet<u32> = HashSet::new();
+    let mut best: Option<Vec<u32>> = None;
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    for start in starts {
+        if seen.contains(&start) {
+            continue;
+        }
+        let mut l = vec![start];
+        seen.insert(start);
+        let mut v = next[&start];
+        while v != start && l.len() <= next.len() {
+            if !seen.insert(v) {
+                l.clear();
+                break;
+            }
+            l.push(v);
+            match next.get(&v) {
+                Some(&w) => v = w,
+                None => {
+                    l.clear();
+                    break;
+                }
+            }
+        }
+        if v == start && l.len() >= 3 && best.as_ref().is_none_or(|b| l.len() > b.len()) {
+            best = Some(l);
+        }
+    }
+    best
+}
+
+/// Vertices of `of` within `reach` mm beyond their least distance to a vertex of `to`.
+fn vertices_near(of: &TriMesh, to: &TriMesh, reach: f32) -> Vec<usize> {
+    let distance = |p: Vec3| {
+        to.vertices
+            .iter()
+            .map(|q| q.distance_squared(p))
+            .fold(f32::INFINITY, f32::min)
+            .sqrt()
+    };
+    let d: Vec<f32> = of.vertices.iter().map(|&p| distance(p)).collect();
+    let least = d.iter().copied().fold(f32::INFINITY, f32::min);
+    (0..d.len()).filter(|&i| d[i] <= least + reach).collect()
+}
+
+fn append(mesh: &mut TriMesh, labels: &mut Vec<u32>, part: &TriMesh, part_labels: &[u32]) {
     let base = mesh.vertices.len() as u32;
     mesh.vertices.extend(&part.vertices);
     mesh.triangles
         .extend(part.triangles.iter().map(|t| t.map(|i| i + base)));
-    labels.extend(std::iter::repeat_n(label, part.vertices.len()));
+    labels.extend(part_labels);
 }
 
 /// A gum band: a wavy strip 3 mm below to 8 mm below the cervical centres, along the arch.

@@ -31,7 +31,7 @@ pub use dentition::{Dentition, GroupLoad, PlacedTooth};
 pub use fdi::{Arch, Fdi, InvalidFdi, Side, ToothKind};
 pub use frame::{CentreParameters, ToothFrame};
 pub use load::{Load, LoadError};
-pub use patient::OrientationReport;
+pub use patient::{LeftOut, MIN_TOOTH_TRIANGLES, OrientationReport, ScanReport};
 #[cfg(feature = "ecs")]
 pub use plugin::{
     ActiveCase, CaseLoadFailed, CaseLoaded, LoadCase, TeethModelPlugin, TeethModelSystems,

@@ -11,9 +11,9 @@ use super::{
     case::{Case, CaseError, LoadedCase},
     fdi::Fdi,
     import::{
-        ImportError, Placement, Prepared, RepairLimits, check_raw, check_scan,
+        ImportError, LabelFix, Placement, Prepared, RepairLimits, check_raw, check_scan,
         orient::{Arranged, REFERENCE_RESOLUTION, as_euler_deg, orient},
-        prepare, read_in_mm, read_labelled, split,
+        prepare_or_rebuild, read_in_mm, read_labelled, split, tidy_labels, trim_bleed,
     },
     tooth_shape::ShapeSet,
 };
@@ -38,6 +38,29 @@ pub struct OrientationReport {
     pub rms_mm: Option<f32>,
 }
 
+/// What the import of a labelled scan changed in its labels, and the labels it left out.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScanReport {
+    /// The scan, as the case names it.
+    pub file: String,
+    /// Second pieces moved, islands dropped, margins trimmed.
+    pub fixes: Vec<LabelFix>,
+    /// Labels that cannot be a tooth, left out of the case with the reason.
+    pub left_out: Vec<LeftOut>,
+}
+
+/// A label left out of a scan's import.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LeftOut {
+    /// FDI number.
+    pub fdi: u8,
+    /// Why, on one line.
+    pub reason: String,
+}
+
+/// A labelled tooth with fewer triangles than this is no tooth: left out of its scan's import.
+pub const MIN_TOOTH_TRIANGLES: usize = 40;
+
 /// One imported tooth's raw mesh, before placement.
 struct Source {
     fdi: Fdi,
@@ -59,6 +82,8 @@ pub(super) struct PatientTeeth {
     pub labelled: Vec<Fdi>,
     /// Where the files went.
     pub orientation: Vec<OrientationReport>,
+    /// What each labelled scan's import changed or left out.
+    pub scans: Vec<ScanReport>,
 }
 
 /// Reads, places and prepares the case's `meshes` and `scans`.
@@ -67,7 +92,7 @@ pub(super) fn patient_teeth(
     arrangement: &Arrangement,
 ) -> Result<PatientTeeth, CaseError> {
     let case = &loaded.case;
-    let sources = read_sources(loaded)?;
+    let (sources, mut scans) = read_sources(loaded)?;
     let labelled: Vec<Fdi> = sources
         .iter()
         .filter(|s| s.scanned)
@@ -146,27 +171,68 @@ pub(super) fn patient_teeth(
             rms_mm: None,
         });
     }
-    // Repair and close, on all cores.
-    let jobs: Vec<(usize, Pose)> = poses.into_iter().enumerate().collect();
+    // Labels past the crown trimmed, where the arrangement says which way is occlusal.
+    let mut trims: Vec<Option<LabelFix>> = vec![None; sources.len()];
+    let mut worlds: Vec<TriMesh> = Vec::with_capacity(sources.len());
+    for (i, s) in sources.iter().enumerate() {
+        let world = s.mesh.map_vertices(|v| poses[i].transform_point(v));
+        if s.scanned {
+            let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
+            let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
+            let (trimmed, fix) = trim_bleed(&world, s.fdi, &an, occlusal);
+            trims[i] = fix;
+            worlds.push(trimmed);
+        } else {
+            worlds.push(world);
+        }
+    }
+    // Repair and close (or rebuild), on all cores.
+    let jobs: Vec<usize> = (0..sources.len()).collect();
     let limits = RepairLimits::default();
-    let prepared = crate::parallel::parallel_map(&jobs, |(i, pose)| {
-        let s = &sources[*i];
-        let world = s.mesh.map_vertices(|v| pose.transform_point(v));
-        prepare(&world, s.fdi, &limits).map_err(|message| CaseError::Mesh {
-            path: s.path.clone(),
-            fdi: s.fdi,
-            case: loaded.origin.clone(),
-            message,
-        })
+    let prepared = crate::parallel::parallel_map(&jobs, |&i| {
+        prepare_or_rebuild(&worlds[i], sources[i].fdi, &limits)
     });
     let mut teeth = Vec::with_capacity(sources.len());
-    for (s, p) in sources.iter().zip(prepared) {
-        teeth.push((s.fdi, p?));
+    let mut kept = Vec::with_capacity(labelled.len());
+    for ((s, p), trim) in sources.iter().zip(prepared).zip(trims) {
+        let report = scans.iter_mut().find(|r| r.file == s.file && s.scanned);
+        if let (Some(r), Some(fix)) = (report, trim) {
+            r.fixes.push(fix);
+        }
+        match p {
+            Ok(p) => {
+                if s.scanned {
+                    kept.push(s.fdi);
+                }
+                teeth.push((s.fdi, p));
+            }
+            // A labelled tooth that is no tooth is left out; its arch imports without it.
+            Err(message) if s.scanned => {
+                if let Some(r) = scans.iter_mut().find(|r| r.file == s.file) {
+                    r.left_out.push(LeftOut {
+                        fdi: s.fdi.number(),
+                        reason: message.to_string(),
+                    });
+                }
+            }
+            Err(message) => {
+                return Err(CaseError::Mesh {
+                    path: s.path.clone(),
+                    fdi: s.fdi,
+                    case: loaded.origin.clone(),
+                    message,
+                });
+            }
+        }
+    }
+    if kept.len() < labelled.len() && case.presence_from_scans() {
+        loaded.check_present(&case.present_with(&kept))?;
     }
     Ok(PatientTeeth {
         teeth,
-        labelled,
+        labelled: kept,
         orientation,
+        scans,
     })
 }
 
@@ -180,7 +246,7 @@ fn scan_error(loaded: &LoadedCase, path: &str, message: String) -> CaseError {
 
 /// Every imported tooth's raw mesh, in millimetres in its file's frame: one per `meshes` entry,
 /// one per labelled tooth of each scan. A tooth given twice is refused.
-fn read_sources(loaded: &LoadedCase) -> Result<Vec<Source>, CaseError> {
+fn read_sources(loaded: &LoadedCase) -> Result<(Vec<Source>, Vec<ScanReport>), CaseError> {
     let case = &loaded.case;
     let mesh_error = |path: &str, fdi: Fdi, message: ImportError| CaseError::Mesh {
         path: path.to_owned(),
@@ -212,27 +278,44 @@ fn read_sources(loaded: &LoadedCase) -> Result<Vec<Source>, CaseError> {
             super::import::Labels::Json(f) => Some(Case::mesh_path(&loaded.origin, f)),
             _ => None,
         };
-        let labelled = read_labelled(&path, &scan.labels, labels_file.as_deref())
+        let mut labelled = read_labelled(&path, &scan.labels, labels_file.as_deref())
             .and_then(|m| check_scan(&m).map(|()| m))
             .map_err(|e| scan_error(loaded, &shown, e.to_string()))?;
+        let mut report = ScanReport {
+            file: scan.file.clone(),
+            fixes: tidy_labels(&mut labelled),
+            left_out: Vec::new(),
+        };
         let scale = scan.units.mm();
-        Ok::<_, CaseError>(
-            split(&labelled)
-                .into_iter()
-                .map(|(fdi, mesh)| Source {
-                    fdi,
-                    file: scan.file.clone(),
-                    path: shown.clone(),
-                    mesh: mesh.map_vertices(|v| v * scale),
-                    placement: scan.transform,
-                    scanned: true,
-                })
-                .collect::<Vec<_>>(),
-        )
+        let mut teeth = Vec::new();
+        for (fdi, mesh) in split(&labelled) {
+            if mesh.triangles.len() < MIN_TOOTH_TRIANGLES {
+                report.left_out.push(LeftOut {
+                    fdi: fdi.number(),
+                    reason: format!(
+                        "{} labelled triangles, fewer than a tooth's {MIN_TOOTH_TRIANGLES}",
+                        mesh.triangles.len()
+                    ),
+                });
+                continue;
+            }
+            teeth.push(Source {
+                fdi,
+                file: scan.file.clone(),
+                path: shown.clone(),
+                mesh: mesh.map_vertices(|v| v * scale),
+                placement: scan.transform,
+                scanned: true,
+            });
+        }
+        Ok::<_, CaseError>((teeth, report))
     });
     let mut seen: BTreeMap<Fdi, String> = sources.iter().map(|s| (s.fdi, s.path.clone())).collect();
+    let mut reports = Vec::new();
     for scan in scans {
-        for s in scan? {
+        let (teeth, report) = scan?;
+        reports.push(report);
+        for s in teeth {
             if let Some(other) = seen.get(&s.fdi) {
                 let what = if case.meshes.0.contains_key(&s.fdi) {
                     format!("also named in `meshes` ({other})")
@@ -252,5 +335,5 @@ fn read_sources(loaded: &LoadedCase) -> Result<Vec<Source>, CaseError> {
             sources.push(s);
         }
     }
-    Ok(sources)
+    Ok((sources, reports))
 }

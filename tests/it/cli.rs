@@ -789,6 +789,68 @@ fn a_labelled_scan_export_is_placed_inspected_and_simulated_without_a_transform(
 }
 
 #[test]
+fn scans_that_fail_as_real_segmentations_import_whole_and_inspect_says_how() {
+    let dir = fresh_dir("faults");
+    succeed(&[
+        "export-case",
+        "--case",
+        "normal",
+        "--out",
+        dir.to_str().unwrap(),
+        "--scan-like",
+        "700",
+        "--labelled",
+        "ply",
+        "--faults",
+        "--seed",
+        "22",
+    ]);
+    let case = dir.join("normal.ron");
+    let report = json_of(&["inspect", "--case", case.to_str().unwrap(), "--json"]);
+    assert_eq!(
+        report["teeth"].as_array().unwrap().len(),
+        32,
+        "no tooth left out"
+    );
+    let scans = report["scans"].as_array().unwrap();
+    assert_eq!(scans.len(), 2);
+    for s in scans {
+        assert!(s["left_out"].as_array().unwrap().is_empty(), "{s}");
+        for f in s["fixes"].as_array().unwrap() {
+            for key in ["label", "action", "to", "triangles", "at"] {
+                assert!(f.get(key).is_some(), "missing {key} in {f}");
+            }
+        }
+    }
+    let rebuilt: Vec<_> = report["imported"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|m| m["repairs"].get("rebuilt"))
+        .collect();
+    assert!(!rebuilt.is_empty(), "{report}");
+    for r in &rebuilt {
+        for key in [
+            "reason",
+            "cell_mm",
+            "mean_mm",
+            "p95_mm",
+            "max_mm",
+            "triangles",
+        ] {
+            assert!(r.get(key).is_some(), "missing {key} in {r}");
+        }
+        assert!(r["mean_mm"].as_f64().unwrap() <= 0.05, "{r}");
+    }
+    // The table says the same in words.
+    let table = succeed(&["inspect", "--case", case.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&table.stdout);
+    assert!(text.contains("labels of upper.ply"), "{text}");
+    assert!(text.contains("rebuilt on a"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn outputs_never_replace_the_case_file_being_read() {
     let dir = fresh_dir("inputs");
     let text = "Case(name: \"odd\", teeth: Only([11, 21]))\n";

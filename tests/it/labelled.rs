@@ -12,7 +12,10 @@ use orthosim::{
             orient::{Arranged, OrientError, orient},
             split,
         },
-        labelled_scan::{LabelledArch, ScanFormat, ScannerFrame, labelled_arch},
+        labelled_scan::{
+            LabelFaults, LabelledArch, ScanFormat, ScannerFrame, labelled_arch, labelled_arch_with,
+            write_scan,
+        },
     },
 };
 
@@ -384,4 +387,83 @@ fn two_mislabelled_teeth_do_not_tilt_the_placement() {
     let found = place(&d, &teeth).unwrap();
     let (mm, deg) = error(&d, &found, &frame);
     assert!(mm <= 0.5 && deg <= 2.0, "{mm} mm, {deg}°");
+}
+
+#[test]
+fn labelled_arches_that_fail_as_real_segmentations_import_whole() {
+    let d = normal();
+    let mut actions = std::collections::BTreeSet::new();
+    for seed in [21u64, 22] {
+        let dir = temp_dir(&format!("faults-{seed}"));
+        let frame = ScannerFrame::random(seed);
+        let mut scans = String::new();
+        for (arch, name) in [(Arch::Upper, "upper"), (Arch::Lower, "lower")] {
+            let scan = labelled_arch_with(&d, arch, 700, seed, &LabelFaults::REAL);
+            let placed = frame.apply(&scan.mesh);
+            let (bytes, _) = write_scan(&scan, &placed, ScanFormat::PlyProperty);
+            std::fs::write(dir.join(format!("{name}.ply")), bytes).unwrap();
+            scans += &format!(
+                r#"(file: "{name}.ply", labels: Property("label"), units: {:?}),"#,
+                frame.units
+            );
+        }
+        let imported = write_case(&dir, &format!(r#"Case(name: "faults", scans: [{scans}])"#))
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        assert_eq!(imported.teeth.len(), 32, "seed {seed}: every tooth imports");
+        assert_eq!(imported.imported.len(), 32, "seed {seed}");
+        assert_eq!(imported.scans.len(), 2);
+        for s in &imported.scans {
+            assert!(s.left_out.is_empty(), "seed {seed}: {:?}", s.left_out);
+            actions.extend(s.fixes.iter().map(|f| f.action));
+            // Fragments on a neighbour go to that neighbour.
+            assert!(
+                s.fixes.iter().any(|f| f.to != 0 && f.to != f.label),
+                "seed {seed}: {:?}",
+                s.fixes
+            );
+        }
+        // The crossed central incisors: rebuilt where the repair could not make them a solid,
+        // and close to the scan.
+        let rebuilt: Vec<_> = imported
+            .imported
+            .iter()
+            .filter_map(|(f, r)| r.rebuilt.as_ref().map(|b| (*f, b)))
+            .collect();
+        assert!(
+            rebuilt.iter().any(|(f, _)| f.arch() == Arch::Upper)
+                && rebuilt.iter().any(|(f, _)| f.arch() == Arch::Lower),
+            "seed {seed}: {rebuilt:?}"
+        );
+        for (f, r) in &rebuilt {
+            assert_eq!(
+                f.kind(),
+                orthosim::teeth::ToothKind::CentralIncisor,
+                "{r:?}"
+            );
+            assert!(r.mean_mm <= 0.05, "seed {seed} {f}: {r:?}");
+        }
+        for t in imported.visible() {
+            t.geometry
+                .mesh
+                .validate_solid()
+                .unwrap_or_else(|e| panic!("seed {seed} {}: {e}", t.fdi));
+            // Placed right: each crown where the case has it (the turned ones aside).
+            if rebuilt.iter().any(|(f, _)| *f == t.fdi) {
+                continue;
+            }
+            let before = d.tooth(t.fdi).unwrap();
+            let up = if t.fdi.arch() == Arch::Lower {
+                Vec3::Y
+            } else {
+                Vec3::NEG_Y
+            };
+            let centre = |p: &orthosim::teeth::PlacedTooth| p.crown_centre();
+            let shift = (centre(t) - centre(before)).reject_from(up).length();
+            assert!(shift < 1.0, "seed {seed} {}: moved {shift} mm", t.fdi);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    for action in ["moved", "dropped", "trimmed"] {
+        assert!(actions.contains(action), "{action}: {actions:?}");
+    }
 }

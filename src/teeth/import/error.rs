@@ -172,6 +172,29 @@ pub enum ImportError {
     NotSolid(MeshError),
 }
 
+impl ImportError {
+    /// True when the mesh holds a tooth's surface that the repair could not make a solid, so a
+    /// rebuild may still give one; false when it is no tooth at all (empty, unreadable,
+    /// non-finite, of a size no tooth has) or the error is in the file or labels.
+    pub fn is_repairable(&self) -> bool {
+        matches!(
+            self,
+            ImportError::SharedEdge { .. }
+                | ImportError::SeveralPieces { .. }
+                | ImportError::Twisted(_)
+                | ImportError::HolesMeet(_)
+                | ImportError::NonManifoldVertex(_)
+                | ImportError::OpenBoundary(_)
+                | ImportError::OpenNotMargin { .. }
+                | ImportError::FlatMargin
+                | ImportError::SelfIntersecting { .. }
+                | ImportError::Degenerate(_)
+                | ImportError::Flat { .. }
+                | ImportError::NotSolid(_)
+        )
+    }
+}
+
 /// What a PLY file lacks.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PlyProblem {

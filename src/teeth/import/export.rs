@@ -13,7 +13,9 @@ use crate::{
         Dentition,
         case::{Case, ToothMap},
         fdi::Arch,
-        labelled_scan::{ScanFormat, ScannerFrame, labelled_arch, tooth_colour, write_scan},
+        labelled_scan::{
+            LabelFaults, ScanFormat, ScannerFrame, labelled_arch_with, tooth_colour, write_scan,
+        },
         scan_like::{ScanDefects, scan_like_crown},
     },
 };
@@ -151,6 +153,21 @@ pub fn export_labelled_scans(
     seed: u64,
     format: ScanFormat,
 ) -> Result<(ExportReport, ScannerFrame), OutputError> {
+    export_labelled_scans_with(d, dir, triangles, seed, format, &LabelFaults::NONE)
+}
+
+/// [`export_labelled_scans`] with labels that fail as real segmentations' do ([`LabelFaults`]).
+///
+/// # Errors
+/// The first output that cannot or must not be written ([`OutputError`]).
+pub fn export_labelled_scans_with(
+    d: &Dentition,
+    dir: &Path,
+    triangles: usize,
+    seed: u64,
+    format: ScanFormat,
+    faults: &LabelFaults,
+) -> Result<(ExportReport, ScannerFrame), OutputError> {
     let (mut case, case_file, inputs) = export_start(d, dir);
     let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
     let extension = match format {
@@ -181,7 +198,7 @@ pub fn export_labelled_scans(
     let mut written = 0;
     let mut scans = Vec::new();
     for a in &arches {
-        let arch = labelled_arch(d, *a, triangles, seed);
+        let arch = labelled_arch_with(d, *a, triangles, seed, faults);
         let placed = frame.apply(&arch.mesh);
         written += placed.triangles.len();
         let (bytes, json) = write_scan(&arch, &placed, format);

@@ -37,8 +37,10 @@ mod labels;
 mod mend;
 pub mod orient;
 mod read;
+pub mod rebuild;
 pub mod repair;
 pub mod root;
+pub mod segments;
 
 use std::path::Path;
 
@@ -55,10 +57,15 @@ use super::{
 use crate::geometry::{MassProperties, Pose, TriMesh};
 
 pub use error::{ImportError, Near, PlyProblem};
-pub use export::{ExportMeshes, ExportReport, export_case, export_case_as, export_labelled_scans};
+pub use export::{
+    ExportMeshes, ExportReport, export_case, export_case_as, export_labelled_scans,
+    export_labelled_scans_with,
+};
 pub use labels::{LabelledMesh, Labels, check_raw, check_scan, read_labelled, split};
 pub use read::{MeshFormat, read_mesh, write_stl};
+pub use rebuild::{Rebuilt, rebuild};
 pub use repair::{RepairLimits, Repairs};
+pub use segments::{LabelFix, tidy_labels, trim_bleed};
 
 /// Units of a mesh file.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -333,6 +340,23 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
         cervical,
         repairs,
     })
+}
+
+/// [`prepare`], and when the repair cannot make a valid solid, the tooth [`rebuild`]t instead.
+///
+/// # Errors
+/// What makes the mesh no tooth at all (see [`rebuild`]); the repair's own error when the
+/// rebuild fails too.
+pub fn prepare_or_rebuild(
+    world: &TriMesh,
+    fdi: Fdi,
+    limits: &RepairLimits,
+) -> Result<Prepared, ImportError> {
+    match prepare(world, fdi, limits) {
+        Ok(p) => Ok(p),
+        Err(e) if !e.is_repairable() => Err(e),
+        Err(e) => rebuild(world, fdi, limits, &e),
+    }
 }
 
 impl Prepared {

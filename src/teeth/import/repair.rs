@@ -87,6 +87,10 @@ pub struct Repairs {
     pub holes_closed_mm: Vec<f32>,
     /// Length (mm) of the cervical margin closed by a generated root, if one was generated.
     pub root_generated_margin_mm: Option<f32>,
+    /// The repair could not make a valid solid, so the tooth was rebuilt from the solid its
+    /// surface encloses ([`super::rebuild`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rebuilt: Option<super::rebuild::Rebuilt>,
 }
 
 impl Repairs {
@@ -146,6 +150,12 @@ impl Repairs {
         }
         if let Some(l) = self.root_generated_margin_mm {
             parts.push(format!("root generated below a {l:.1} mm cervical margin"));
+        }
+        if let Some(r) = &self.rebuilt {
+            parts.push(format!(
+                "rebuilt on a {} mm grid as the repair could not make a solid ({}): the scan lies {:.3} mm from it on average, {:.3} mm at the 95th percentile, {:.3} mm at most",
+                r.cell_mm, r.reason, r.mean_mm, r.p95_mm, r.max_mm
+            ));
         }
         if parts.is_empty() {
             "nothing".into()

@@ -121,6 +121,20 @@ pub fn close_with_root(
     gap: f32,
 ) -> Result<(Vec3, Vec3), ImportError> {
     let (centre, apical) = margin_axis(mesh, l)?;
+    close_with_root_along(mesh, l, root_length, gap, centre, apical);
+    Ok((centre, apical))
+}
+
+/// [`close_with_root`] along a given unit `apical` direction from the margin's `centre` (for a
+/// margin whose own normal is not to be trusted, such as one the labels bled into).
+pub fn close_with_root_along(
+    mesh: &mut TriMesh,
+    l: &[u32],
+    root_length: f32,
+    gap: f32,
+    centre: Vec3,
+    apical: Vec3,
+) {
     let f = Focus::new(mesh, centre, apical, root_length);
     let (c, a, u, w) = (f.c, f.a, f.u, f.w);
     let h0 = f.deepest + f64::from(gap);
@@ -153,7 +167,6 @@ pub fn close_with_root(
         let (p, q) = (prev[i], prev[(i + 1) % prev.len()]);
         mesh.triangles.push([q, p, apex]);
     }
-    Ok((centre, apical))
 }
 
 /// Where the collar's strips converge: a point on the root's axis one root length beyond the
