@@ -102,17 +102,32 @@ fn print_table(report: &InspectReport) {
             continue;
         }
         println!("labels of {}:", scan.file);
+        // Fixes of one kind grouped: islands come by the dozen in real scans.
+        let mut groups: Vec<(&str, u8, u8, usize, usize)> = Vec::new();
         for f in &scan.fixes {
-            let [x, y, z] = f.at;
-            let to = match (f.action, f.to) {
+            match groups
+                .iter_mut()
+                .find(|g| (g.0, g.1, g.2) == (f.action, f.label, f.to))
+            {
+                Some(g) => {
+                    g.3 += 1;
+                    g.4 += f.triangles;
+                }
+                None => groups.push((f.action, f.label, f.to, 1, f.triangles)),
+            }
+        }
+        for (action, label, to, pieces, triangles) in groups {
+            let to = match (action, to) {
                 ("trimmed", _) => "past the crown".to_owned(),
                 (_, 0) => "to the gum".to_owned(),
                 (_, n) => format!("to {n}"),
             };
-            println!(
-                "  {} {}: {} triangles {to}, near ({x:.2}, {y:.2}, {z:.2}) mm",
-                f.action, f.label, f.triangles
-            );
+            let pieces = if pieces > 1 {
+                format!("{pieces} pieces, ")
+            } else {
+                String::new()
+            };
+            println!("  {action} {label}: {pieces}{triangles} triangles {to}");
         }
         for l in &scan.left_out {
             println!("  left out {}: {}", l.fdi, l.reason);

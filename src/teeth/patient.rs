@@ -171,6 +171,19 @@ pub(super) fn patient_teeth(
             rms_mm: None,
         });
     }
+    // The label fixes' places, from the scans' frames (mm) to orthosim's.
+    for report in &mut scans {
+        if let Some(i) = sources
+            .iter()
+            .position(|s| s.scanned && s.file == report.file)
+        {
+            for fix in &mut report.fixes {
+                fix.at = poses[i]
+                    .transform_point(glam::Vec3::from_array(fix.at))
+                    .to_array();
+            }
+        }
+    }
     // Labels past the crown trimmed, where the arrangement says which way is occlusal.
     let mut trims: Vec<Option<LabelFix>> = vec![None; sources.len()];
     let mut worlds: Vec<TriMesh> = Vec::with_capacity(sources.len());
@@ -281,12 +294,16 @@ fn read_sources(loaded: &LoadedCase) -> Result<(Vec<Source>, Vec<ScanReport>), C
         let mut labelled = read_labelled(&path, &scan.labels, labels_file.as_deref())
             .and_then(|m| check_scan(&m).map(|()| m))
             .map_err(|e| scan_error(loaded, &shown, e.to_string()))?;
+        let scale = scan.units.mm();
+        let mut fixes = tidy_labels(&mut labelled);
+        for fix in &mut fixes {
+            fix.at = fix.at.map(|x| x * scale);
+        }
         let mut report = ScanReport {
             file: scan.file.clone(),
-            fixes: tidy_labels(&mut labelled),
+            fixes,
             left_out: Vec::new(),
         };
-        let scale = scan.units.mm();
         let mut teeth = Vec::new();
         for (fdi, mesh) in split(&labelled) {
             if mesh.triangles.len() < MIN_TOOTH_TRIANGLES {

@@ -45,8 +45,7 @@ pub struct LabelFix {
     pub to: u8,
     /// Triangles changed.
     pub triangles: usize,
-    /// Their centre (mm, in the scan's frame for moved and dropped pieces, orthosim's frame for
-    /// trimmed ones).
+    /// Their centre (mm; in orthosim's frame once the scan is placed).
     pub at: [f32; 3],
 }
 
@@ -216,7 +215,8 @@ fn edges_of(mesh: &TriMesh, ids: &[u32], t: usize) -> [(u32, u32); 3] {
 }
 
 /// Leaves out the triangles of tooth `fdi`'s raw crown `mesh` (orthosim's frame) with a corner
-/// past the crown (see the module doc); `occlusal` is the tooth's occlusal direction. The fix says
+/// past the crown (see the module doc) that hang from an opening of the surface (a spike inside
+/// the crown is the repair's); `occlusal` is the tooth's occlusal direction. The fix says
 /// what was trimmed, `None` when nothing was.
 pub fn trim_bleed(
     mesh: &TriMesh,
@@ -252,8 +252,11 @@ pub fn trim_bleed(
     let mut kept = Vec::with_capacity(mesh.triangles.len());
     let (mut cut, mut sum) = (0usize, Vec3::ZERO);
     let beyond: Vec<bool> = mesh.vertices.iter().map(|&p| past(p)).collect();
+    let cut_here = reaching_the_margin(mesh, |t| {
+        mesh.triangles[t].iter().any(|&v| beyond[v as usize])
+    });
     for (t, tri) in mesh.triangles.iter().enumerate() {
-        if tri.iter().any(|&v| beyond[v as usize]) {
+        if cut_here[t] {
             let [a, b, c] = mesh.triangle(t);
             cut += 1;
             sum += (a + b + c) / 3.0;
@@ -275,6 +278,48 @@ pub fn trim_bleed(
         TriMesh::new(mesh.vertices.clone(), kept).without_unused_vertices(),
         Some(fix),
     )
+}
+
+/// The triangles for which `past` holds that are joined (through such triangles, along shared
+/// vertices) to an opening of the surface: what bled past the crown hangs from its margin, while
+/// a spike's fan or a pit inside the crown does not.
+fn reaching_the_margin(mesh: &TriMesh, past: impl Fn(usize) -> bool) -> Vec<bool> {
+    let n = mesh.triangles.len();
+    let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut by_vertex: HashMap<u32, Vec<usize>> = HashMap::new();
+    let mut queue = Vec::new();
+    let mut reached = vec![false; n];
+    for t in (0..n).filter(|&t| past(t)) {
+        let tri = mesh.triangles[t];
+        for v in tri {
+            by_vertex.entry(v).or_default().push(t);
+        }
+        let open = (0..3).any(|k| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            uses[&(a.min(b), a.max(b))] == 1
+        });
+        if open {
+            reached[t] = true;
+            queue.push(t);
+        }
+    }
+    while let Some(t) = queue.pop() {
+        for v in mesh.triangles[t] {
+            for &o in &by_vertex[&v] {
+                if !reached[o] {
+                    reached[o] = true;
+                    queue.push(o);
+                }
+            }
+        }
+    }
+    reached
 }
 
 #[cfg(test)]
@@ -376,8 +421,16 @@ mod tests {
             .map(|v| Vec3::new(v.x, 0.0, v.z).length())
             .fold(0.0, f32::max);
         assert!(reach <= 2.5 + 1e-5, "{reach}");
-        // A crown with nothing past it is left as it is.
-        let crown = TriMesh::new(mesh.vertices.clone(), mesh.triangles[..24].to_vec());
+        // A crown with nothing past it is left as it is, and so is one whose cap has a spike
+        // (the repair smooths spikes; they hang from no opening).
+        let mut crown = TriMesh::new(mesh.vertices.clone(), mesh.triangles[..24].to_vec());
+        assert!(trim_bleed(&crown, fdi, &an, Vec3::Y).1.is_none());
+        crown
+            .vertices
+            .push(Vec3::new(9.0, an.crown_length + 0.5, 0.0));
+        crown
+            .triangles
+            .extend((0..12u32).map(|k| [36, (k + 1) % 12, k]));
         assert!(trim_bleed(&crown, fdi, &an, Vec3::Y).1.is_none());
     }
 }
