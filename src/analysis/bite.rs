@@ -1,34 +1,86 @@
-//! The bite: the lower arch closed onto the upper as one rigid body under a bite force, until it is
-//! stable (`orthosim occlusion --settle`).
+//! The bite: the mandible closed about its condyles onto the upper arch under a bite force, until
+//! it is stable (`orthosim occlusion --settle`).
 //!
-//! Quasi-static settle. The lower arch rises along the occlusal direction (+y) under a bite force
-//! whose line passes through the centroid of its crown centres. Every opposing pair whose boxes
-//! come near carries a lower bound on its gap; each iteration measures with the exact mesh
-//! distance the pairs whose bound is near contact (queries bounded to [`SETTLE_LIMIT_MM`]: a
-//! farther pair only learns that it is farther); pairs within [`CONTACT_MM`] are contacts, each pushing along its normal (from the upper tooth's closest
-//! point to the lower's). The lower arch's motion is the bite force's, less what the contacts
-//! take (the contact solve of the PDL model on two bodies: the upper arch fixed, the lower with a
-//! mobility of 1 mm per N in translation and 1/R² in rotation, R = [`TURN_RADIUS_MM`]). It moves
-//! by conservative advancement: a step never longer than the smallest gap of the pairs not in
-//! contact, less [`TARGET_GAP_MM`], divided by the fastest speed any point of the arch can have;
-//! pairs in contact are checked afterwards and a step that brings any pair closer than
+//! Quasi-static settle. The mandible (the lower arch) is one rigid body under a bite force of
+//! [`BITE_FORCE_N`] along the occlusal direction (+y) through the centroid of its crown centres,
+//! held by its condyles and by the teeth it meets. Each condyle rests in its fossa at
+//! [`condyle_seat`] (the excursion model's condyles): the fossa's roof, the posterior slope of the
+//! articular eminence (at the condylar guidance angle) and its medial wall stop it going up, back
+//! or towards the midline, so a seated condyle can only turn in place, drop, or slide forwards
+//! and down the eminence; each stop is a contact of the condyle with the skull while the condyle
+//! is within [`CONTACT_MM`] of it. So the mandible closes about the hinge through its condyles,
+//! and slides within the condylar guidance where the teeth push it.
+//!
+//! Every opposing pair of teeth whose boxes come near carries a lower bound on its gap; each
+//! iteration measures with the exact mesh distance the pairs whose bound is near contact (queries
+//! bounded to [`SETTLE_LIMIT_MM`]: a farther pair only learns that it is farther); pairs within
+//! [`CONTACT_MM`] are contacts, each pushing along its normal (from the upper tooth's closest point
+//! to the lower's). The mandible's motion is the bite force's, less what the contacts and the
+//! condyles take (the contact solve of the PDL model on two bodies: the skull fixed, the mandible
+//! with a mobility of 1 mm per N in translation and 1/R² in rotation, R = [`TURN_RADIUS_MM`]). It
+//! moves by conservative advancement: a step never longer than the smallest gap of the pairs not
+//! in contact, less [`TARGET_GAP_MM`], divided by the fastest speed any point of the arch can
+//! have; pairs in contact are checked afterwards and a step that brings any pair closer than
 //! [`TARGET_GAP_MM`] / 2 is halved. So the arches never interpenetrate (the exact stage's
-//! guarantee, tested). The bite is stable when the contacts take the whole force (the motion
-//! left is under [`STILL_MM`] per unit step): the line of the bite force then lies inside the
-//! contacts' support.
+//! guarantee, tested). The bite is stable when the contacts and condyles take the whole force (the
+//! motion left is under [`STILL_MM`] per unit step): the line of the bite force then lies inside
+//! their support. The loads on the condyles are reported.
+//!
+//! Arches that start interpenetrating (as segmentations of real patients do) are first opened
+//! about the hinge until every pair is at least [`TARGET_GAP_MM`] apart; that opening (at the
+//! incisors) is reported. A settle asked to start open turns the mandible open about the hinge
+//! until its crown centroid has dropped by the opening asked.
 //!
 //! Why a bite cannot become stable is said: the arches do not meet within the travel, or the
 //! lower arch keeps sliding off its contacts after [`MAX_ITERATIONS`].
 
-use glam::{DMat3, DVec3, Vec3};
+use glam::{DMat3, DVec3, Quat, Vec2, Vec3};
 use serde::Serialize;
 
-use super::measures::{Posed, occlusal_contacts};
+use super::{
+    excursion::{
+        CONDYLAR_GUIDANCE_DEG, CONDYLE_ABOVE_MM, CONDYLE_BEHIND_MM, CONDYLE_HALF_WIDTH_MM,
+    },
+    measures::{Posed, occlusal_contacts},
+};
 use crate::{
     geometry::{Mat6, Pose, halves, mesh_separation, mesh_separation_within, vec6},
     movement::pdl::{ContactRow, PdlBody, SolveParams, solve_contacts},
     teeth::{Arch, Fdi, ToothKind},
 };
+
+/// The bite force of a settle (N): a moderate clench.
+pub const BITE_FORCE_N: f64 = 100.0;
+
+/// Where the condyle of `side` (+1: the patient's left, −1: the right) sits in its fossa, in the
+/// frame where the case places the lower arch.
+pub fn condyle_seat(side: f32) -> Vec3 {
+    Vec3::new(
+        side * CONDYLE_HALF_WIDTH_MM,
+        CONDYLE_ABOVE_MM,
+        -CONDYLE_BEHIND_MM,
+    )
+}
+
+/// The directions in which the skull pushes a seated condyle of `side`: down and back off the
+/// eminence's posterior slope, forwards off the fossa's back, and outwards off its medial wall.
+fn condyle_stops(side: f32) -> [DVec3; 3] {
+    let (sin, cos) = f64::from(CONDYLAR_GUIDANCE_DEG).to_radians().sin_cos();
+    [
+        DVec3::new(0.0, -cos, -sin),
+        DVec3::Z,
+        DVec3::new(f64::from(side), 0.0, 0.0),
+    ]
+}
+
+/// Loads on the condyles (N).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CondyleLoads {
+    /// The patient's left condyle.
+    pub left: f32,
+    /// The right condyle.
+    pub right: f32,
+}
 
 /// Pairs this close (mm) are in contact.
 pub const CONTACT_MM: f32 = 0.02;
@@ -93,6 +145,11 @@ pub struct Bite {
     pub lower_turn_deg: f32,
     /// Iterations of the settle.
     pub iterations: usize,
+    /// How far the arches were opened about the hinge before the settle because they started
+    /// interpenetrating (mm, at the lower incisors; 0 when they did not).
+    pub opened_mm: f32,
+    /// Loads the condyles carry in the bite (N, under [`BITE_FORCE_N`]; 0 without a settle).
+    pub condyles: CondyleLoads,
     /// Where the lower arch ended, relative to where the case placed it.
     #[serde(skip)]
     pub lower_pose: Pose,
@@ -236,8 +293,8 @@ impl<'a, 'b> Tracker<'a, 'b> {
     }
 }
 
-/// The bite of `teeth` as they stand (`settle` false) or with the lower arch closed onto the
-/// upper from `opening_mm` apart (see the module doc).
+/// The bite of `teeth` as they stand (`settle` false) or with the mandible closed about its
+/// condyles onto the upper arch from `opening_mm` apart (see the module doc).
 pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite {
     let lower: Vec<&Posed> = teeth.iter().filter(|t| !upper(t)).collect();
     let centre = lower
@@ -245,24 +302,61 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         .map(|t| t.pose.transform_point(t.geometry.frame.crown_centre))
         .sum::<Vec3>()
         / lower.len().max(1) as f32;
-    // Farthest a lower-arch point lies from the centre: bounds a point's speed under a turn.
-    let reach = lower
-        .iter()
-        .flat_map(|t| {
+    let lower_points = || {
+        lower.iter().flat_map(|t| {
             t.geometry
                 .mesh
                 .vertices
                 .iter()
-                .map(|v| t.pose.transform_point(*v).distance(centre))
+                .map(|v| t.pose.transform_point(*v))
         })
+    };
+    // Farthest a lower-arch point lies from the centre: bounds a point's speed under a turn.
+    let reach = lower_points()
+        .map(|p| p.distance(centre))
         .fold(0.0f32, f32::max) as f64;
-    let mut moved = Pose::from_translation(Vec3::new(0.0, -opening_mm.max(0.0), 0.0));
-    if !settle {
-        moved = Pose::IDENTITY;
+    // The hinge: turning by φ about the axis through the seated condyles (positive opens).
+    let right = condyle_seat(-1.0);
+    let hinge = |phi: f32| {
+        let q = Quat::from_axis_angle(Vec3::X, phi);
+        Pose::new(q, right - q * right)
+    };
+    let from_hinge = |p: Vec3| Vec2::new(p.y - right.y, p.z - right.z).length();
+    let incisal = lower_points()
+        .max_by(|a, b| a.z.total_cmp(&b.z))
+        .unwrap_or(centre);
+    let mut moved = Pose::IDENTITY;
+    let mut opened_mm = 0.0;
+    if settle {
+        moved = hinge(opening_mm.max(0.0) / from_hinge(centre).max(1.0));
+        // Interpenetrating arches are opened along the hinge until every pair is clear.
+        let least_at = |phi: f32| {
+            let pose = hinge(phi).mul(&moved);
+            let mut pairs = Tracker::boxed(teeth, &pose, 0.0);
+            pairs.refresh_within(&pose, f32::INFINITY, TARGET_GAP_MM);
+            pairs.least_measured()
+        };
+        if least_at(0.0) < TARGET_GAP_MM {
+            let (mut shut, mut open) = (0.0f32, 0.25f32.to_radians());
+            while least_at(open) < TARGET_GAP_MM && open < 20f32.to_radians() {
+                (shut, open) = (open, 2.0 * open);
+            }
+            for _ in 0..24 {
+                let mid = 0.5 * (shut + open);
+                if least_at(mid) < TARGET_GAP_MM {
+                    shut = mid;
+                } else {
+                    open = mid;
+                }
+            }
+            moved = hinge(open).mul(&moved);
+            opened_mm = open * from_hinge(incisal);
+        }
     }
     let mut iterations = 0;
     let mut why = None;
     let mut stable = false;
+    let mut condyles = CondyleLoads::default();
     let mobility = {
         let mut m = Mat6::identity();
         for k in 3..6 {
@@ -277,12 +371,13 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         max_sweeps: 2_000,
     };
     let travel_limit = opening_mm.max(0.0) + 10.0;
+    let start = moved.transform_point(centre);
     let mut pairs = Tracker::boxed(teeth, &moved, opening_mm.max(0.0) + 3.0);
     pairs.refresh_within(&moved, f32::INFINITY, SETTLE_LIMIT_MM);
     loop {
         pairs.refresh_within(&moved, 2.0 * CONTACT_MM, SETTLE_LIMIT_MM);
         let c = moved.transform_point(centre).as_dvec3();
-        let contacts: Vec<ContactRow> = pairs
+        let mut contacts: Vec<ContactRow> = pairs
             .last
             .iter()
             .flatten()
@@ -298,6 +393,27 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
                 })
             })
             .collect();
+        let touching = contacts.len();
+        // The condyles' stops (only while settling: as placed, the bite is the teeth's).
+        let mut sides = Vec::new();
+        if settle {
+            for side in [1.0f32, -1.0] {
+                let seat = condyle_seat(side);
+                let at = moved.transform_point(seat);
+                for normal in condyle_stops(side) {
+                    if (at - seat).as_dvec3().dot(normal) <= f64::from(CONTACT_MM) {
+                        contacts.push(ContactRow {
+                            a: 0,
+                            b: 1,
+                            point: at.as_dvec3(),
+                            normal,
+                            bias: 0.0,
+                        });
+                        sides.push(side);
+                    }
+                }
+            }
+        }
         let bodies = [
             PdlBody {
                 centre: DVec3::ZERO,
@@ -317,12 +433,25 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         let solve = solve_contacts(&bodies, &contacts, None, &params);
         let (u, w) = halves(&solve.twists[1]);
         let speed = u.length() + w.length() * reach;
-        if !contacts.is_empty() && speed < STILL_MM {
+        if touching > 0 && speed < STILL_MM {
             stable = true;
+            // Each condyle's load: the force its stops exert together.
+            let mut on = [DVec3::ZERO; 2];
+            for ((f, row), side) in solve.forces[touching..]
+                .iter()
+                .zip(&contacts[touching..])
+                .zip(&sides)
+            {
+                on[usize::from(*side < 0.0)] += row.normal * *f * BITE_FORCE_N;
+            }
+            condyles = CondyleLoads {
+                left: on[0].length() as f32,
+                right: on[1].length() as f32,
+            };
             break;
         }
         if !settle {
-            why = Some(if contacts.is_empty() {
+            why = Some(if touching == 0 {
                 "the arches do not touch".to_owned()
             } else {
                 "the contacts do not hold the bite force: the lower arch would slide or tilt"
@@ -332,8 +461,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         }
         if iterations >= MAX_ITERATIONS {
             why = Some(format!(
-                "the lower arch still slides after {MAX_ITERATIONS} steps ({} contacts)",
-                contacts.len()
+                "the lower arch still slides after {MAX_ITERATIONS} steps ({touching} contacts)"
             ));
             break;
         }
@@ -351,7 +479,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
             1.0 / speed
         };
         // Sliding on contacts: small steps, at most 0.05 mm at the fastest point.
-        if !contacts.is_empty() {
+        if touching > 0 {
             step = step.min(0.05 / speed);
         }
         let mut accepted = false;
@@ -368,7 +496,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
             }
             step *= 0.5;
         }
-        let risen = moved.translation.y + opening_mm.max(0.0);
+        let risen = start.distance(moved.transform_point(centre));
         if !accepted || step * speed < 1e-7 {
             why = Some(
                 "the lower arch is wedged: no step along the bite force keeps the arches apart"
@@ -376,7 +504,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
             );
             break;
         }
-        if contacts.is_empty() && risen > travel_limit {
+        if touching == 0 && risen > travel_limit {
             why = Some(format!(
                 "the arches do not meet within {travel_limit:.0} mm of closing"
             ));
@@ -466,9 +594,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
     }
     let angle = 2.0 * moved.rotation.w.abs().min(1.0).acos();
     let shift = if settle {
-        moved
-            .transform_point(centre)
-            .distance(centre + Vec3::new(0.0, -opening_mm.max(0.0), 0.0))
+        moved.transform_point(centre).distance(start)
     } else {
         0.0
     };
@@ -483,6 +609,8 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         lower_travel_mm: shift,
         lower_turn_deg: angle.to_degrees(),
         iterations,
+        opened_mm,
+        condyles,
         lower_pose: moved,
         excursion: None,
     }

@@ -74,10 +74,21 @@ pub fn run(args: OcclusionArgs) -> Result<()> {
             .as_deref()
             .map_or(String::new(), |w| format!(" ({w})"))
     );
-    if args.settle {
+    if args.settle || b.excursion.is_some() {
+        if b.opened_mm > 0.0 {
+            println!(
+                "the arches started interpenetrating: opened {:.3} mm at the incisors about the condylar hinge first",
+                b.opened_mm
+            );
+        }
         println!(
-            "settle: {} steps, lower arch moved {:.3} mm and turned {:.2}°",
-            b.iterations, b.lower_travel_mm, b.lower_turn_deg
+            "settle: {} steps, lower arch moved {:.3} mm and turned {:.2}°; condyles carry left {:.1} N, right {:.1} N of a {} N bite",
+            b.iterations,
+            b.lower_travel_mm,
+            b.lower_turn_deg,
+            b.condyles.left,
+            b.condyles.right,
+            orthosim::analysis::bite::BITE_FORCE_N
         );
     }
     println!(

@@ -2,8 +2,8 @@
 //! interpenetrating; what `orthosim occlusion` reports.
 
 use orthosim::{
-    analysis::{bite, measures::Posed},
-    teeth::{Case, Dentition},
+    analysis::{bite, bite::BITE_FORCE_N, measures::Posed},
+    teeth::{Arch, Case, Dentition},
 };
 
 fn dentition(case: &str) -> Dentition {
@@ -57,25 +57,82 @@ fn the_normal_arrangement_is_a_class_one_bite_that_settles_without_penetration()
         let Some(opening) = opening else { continue };
         assert!(b.stable, "{opening} mm: {:?}", b.why);
         assert!(b.why.is_none());
-        // It closed from the opening: the lower arch rose by about the opening.
-        assert!(b.lower_travel_mm >= opening, "{b:?}");
+        // It closed from the opening about the condyles: the lower arch rose by about the
+        // opening, back to where the arrangement has it.
+        assert!(b.lower_travel_mm >= 0.95 * opening, "{b:?}");
+        assert!(b.opened_mm == 0.0, "{b:?}");
+        // The teeth take most of the bite force; the condyles the rest.
+        let condyles = b.condyles.left + b.condyles.right;
+        assert!(condyles < 0.5 * BITE_FORCE_N as f32, "{b:?}");
     }
 }
 
 #[test]
-fn a_bite_without_antagonists_says_why() {
+fn a_mandible_without_posterior_teeth_rests_on_its_condyles_and_incisors() {
     let mut d = dentition("normal");
-    // No lower posterior teeth: the lower arch tilts on its incisors and never holds.
+    // No lower posterior teeth: the mandible closes about its condyles until the incisors meet;
+    // the condyles and the front teeth hold the bite, the condyles taking most of it.
     for t in &mut d.teeth {
-        if t.fdi.arch() == orthosim::teeth::Arch::Lower && t.fdi.kind().is_posterior() {
+        if t.fdi.arch() == Arch::Lower && t.fdi.kind().is_posterior() {
             t.extracted = true;
         }
     }
     let teeth = Posed::of_dentition(&d);
     let b = bite("normal", &teeth, true, 2.0);
-    assert!(!b.stable, "{b:?}");
-    assert!(b.why.as_deref().is_some_and(|w| !w.is_empty()));
+    assert!(b.stable, "{b:?}");
     assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+    assert!(
+        b.contacts.iter().all(|c| !c.lower.kind().is_posterior()),
+        "{b:?}"
+    );
+    let condyles = b.condyles.left + b.condyles.right;
+    assert!(condyles > 0.5 * BITE_FORCE_N as f32, "{b:?}");
+    assert!(
+        (b.condyles.left - b.condyles.right).abs() < 0.2 * condyles,
+        "{b:?}"
+    );
+}
+
+#[test]
+fn a_bite_that_cannot_close_says_why() {
+    let mut d = dentition("normal");
+    // Upper molars over lower incisors only: nothing ever meets.
+    for t in &mut d.teeth {
+        let keep = match t.fdi.arch() {
+            Arch::Upper => t.fdi.kind().is_molar(),
+            Arch::Lower => !t.fdi.kind().is_posterior(),
+        };
+        t.extracted = !keep;
+    }
+    let teeth = Posed::of_dentition(&d);
+    let b = bite("normal", &teeth, true, 2.0);
+    assert!(!b.stable, "{b:?}");
+    assert!(
+        b.why.as_deref().is_some_and(|w| w.contains("do not meet")),
+        "{b:?}"
+    );
+    let placed = bite("normal", &teeth, false, 0.0);
+    assert_eq!(placed.why.as_deref(), Some("the arches do not touch"));
+}
+
+#[test]
+fn interpenetrating_arches_are_opened_about_the_hinge_then_settle() {
+    let d = dentition("normal");
+    let mut teeth = Posed::of_dentition(&d);
+    // The lower arch pushed 0.3 mm into the upper, as a segmentation may leave it.
+    for t in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Lower) {
+        t.pose.translation.y += 0.3;
+    }
+    let placed = bite("normal", &teeth, false, 0.0);
+    assert!(placed.max_penetration_mm > 0.2, "{placed:?}");
+    let b = bite("normal", &teeth, true, 0.0);
+    assert!(b.opened_mm > 0.2, "{b:?}");
+    assert!(b.stable, "{b:?}");
+    assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+    assert!(
+        b.contact_teeth.left >= 4 && b.contact_teeth.right >= 4,
+        "{b:?}"
+    );
 }
 
 #[test]
