@@ -4,8 +4,12 @@
 //! Hinge-and-slide condyles: the condyles sit [`CONDYLE_HALF_WIDTH_MM`] either side of the
 //! midline, [`CONDYLE_BEHIND_MM`] behind the frame's origin and [`CONDYLE_ABOVE_MM`] above the
 //! occlusal plane. In protrusion by h both slide forward h and down h·tan(θ), θ =
-//! [`CONDYLAR_GUIDANCE_DEG`]; in a lateral by h the lower arch shifts h sideways, the working
-//! condyle (the side the jaw moves to) turns in place and the other slides down h·tan(θ). At each
+//! [`CONDYLAR_GUIDANCE_DEG`]. In a lateral by h the mandible turns about the vertical through the
+//! working condyle (the side the jaw moves to; the Bennett movement without immediate side shift)
+//! until the incisal point has moved h sideways, so the working-side teeth move outwards and a
+//! little forwards (the arms of a gothic-arch tracing) and the other condyle travels forwards
+//! and drops down its eminence by its travel·tan(θ), tilting the arch about the anteroposterior
+//! line through the working condyle. At each
 //! step the lower arch then closes about the axis through the condyles until its teeth meet the
 //! upper arch (conservative advancement on the closing angle with the exact mesh distance, so the
 //! arches never interpenetrate).
@@ -17,8 +21,9 @@
 //! than that are never opened). The step taken is the least any bound allows, so it stays
 //! conservative whichever pairs were measured.
 //!
-//! Guidance at each step (contacts within [`super::bite::AREA_TOLERANCE_MM`]): `anterior` when
-//! only incisors and canines touch, `canine` when on the working side only the canine touches,
+//! Guidance at each step (contacts within [`super::bite::AREA_TOLERANCE_MM`]): in protrusion,
+//! `anterior` when incisors or canines touch each other and `posterior` when only posterior teeth
+//! guide; in laterals, `anterior` when only incisors and canines touch, `canine` when on the working side only the canine touches,
 //! `group function` when premolars or molars of the working side touch too, `none` when nothing
 //! touches. Interferences: posterior contacts in protrusion, non-working-side contacts in
 //! laterals.
@@ -173,14 +178,17 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
                 } else {
                     -1.0
                 };
-                // The working condyle (side s) stays; the other drops and the arch tilts about
-                // the anteroposterior line through the working condyle, then shifts sideways.
+                // The mandible turns about the vertical through the working condyle (side s)
+                // until the incisal point has moved h sideways; the other condyle travels
+                // forwards, drops down its eminence, and the arch tilts about the
+                // anteroposterior line through the working condyle.
                 let working = condyle(s);
-                let drop = h * tan;
+                let spin = Quat::from_rotation_y(s * h / (incisal.z - working.z));
+                let turn = Pose::new(spin, working - spin * working);
+                let forward = turn.transform_point(condyle(-s)).z - condyle(-s).z;
+                let drop = forward.max(0.0) * tan;
                 let tilt = Quat::from_rotation_z(s * (drop / (2.0 * CONDYLE_HALF_WIDTH_MM)).atan());
-                let turn = Pose::new(tilt, working - tilt * working);
-                let shift = Pose::from_translation(Vec3::new(s * h, 0.0, 0.0));
-                let slide = shift.mul(&turn);
+                let slide = Pose::new(tilt, working - tilt * working).mul(&turn);
                 (
                     slide,
                     slide.transform_point(condyle(1.0)),
@@ -300,7 +308,11 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         let guidance = if contacts.is_empty() {
             "none"
         } else if kind == ExcursionKind::Protrusive {
-            "anterior"
+            if contacts.iter().any(|[u, l]| anterior(*u) && anterior(*l)) {
+                "anterior"
+            } else {
+                "posterior"
+            }
         } else {
             let on_working: Vec<&[Fdi; 2]> = contacts
                 .iter()

@@ -157,7 +157,7 @@ fn excursions_keep_contact_and_flag_guidance_and_interferences() {
                 s.min_gap_mm >= 0.0 && s.min_gap_mm <= 0.05,
                 "{kind:?} {s:?}"
             );
-            assert!(["anterior", "canine", "group function"].contains(&s.guidance));
+            assert!(["anterior", "canine", "group function", "posterior"].contains(&s.guidance));
             for pair in &s.interferences {
                 assert!(s.contacts.contains(pair));
             }
@@ -175,6 +175,31 @@ fn excursions_keep_contact_and_flag_guidance_and_interferences() {
         }
         // The front teeth guide the jaw open as it slides.
         assert!(e.steps[3].opening_mm > 0.5, "{kind:?} {:?}", e.steps[3]);
+        // They disclude the posterior teeth: on the working side from 0.5 to 3 mm of a lateral,
+        // everywhere past 1 mm of protrusion up to 3 mm.
+        let side = |f: orthosim::teeth::Fdi| if matches!(f.quadrant(), 2 | 3) { 1 } else { -1 };
+        for s in e.steps.iter().filter(|s| s.mm <= 3.0 + 1e-3) {
+            let posterior = |[u, l]: &[orthosim::teeth::Fdi; 2]| {
+                u.kind().is_posterior() || l.kind().is_posterior()
+            };
+            match kind {
+                ExcursionKind::Protrusive if s.mm > 1.0 + 1e-3 => {
+                    assert!(!s.contacts.iter().any(posterior), "{s:?}");
+                    assert_eq!(s.guidance, "anterior", "{s:?}");
+                }
+                ExcursionKind::Protrusive => {}
+                _ => {
+                    let working = if kind == ExcursionKind::Left { 1 } else { -1 };
+                    assert!(
+                        !s.contacts
+                            .iter()
+                            .any(|c| posterior(c) && side(c[0]) == working),
+                        "{kind:?} {s:?}"
+                    );
+                    assert!(s.interferences.is_empty(), "{kind:?} {s:?}");
+                }
+            }
+        }
     }
 }
 
