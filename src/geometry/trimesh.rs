@@ -391,6 +391,19 @@ impl TriMesh {
         (piece, count as usize)
     }
 
+    /// The triangles of one piece (`piece` numbers each triangle's piece, as
+    /// [`TriMesh::edge_pieces`] gives them), every vertex kept.
+    pub fn keeping_piece(&self, piece: &[u32], keep: u32) -> Self {
+        let triangles = self
+            .triangles
+            .iter()
+            .zip(piece)
+            .filter(|(_, p)| **p == keep)
+            .map(|(t, _)| *t)
+            .collect();
+        Self::new(self.vertices.clone(), triangles)
+    }
+
     /// The edges used by one triangle only (the openings' edges), as (smaller, larger) vertex
     /// index, whatever the triangles' winding.
     pub fn open_edges(&self) -> Vec<(u32, u32)> {

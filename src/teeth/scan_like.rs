@@ -245,14 +245,7 @@ fn largest_piece(mesh: TriMesh) -> TriMesh {
         sizes[p as usize] += 1;
     }
     let main = (0..count).max_by_key(|&i| sizes[i]).unwrap_or(0) as u32;
-    let triangles = mesh
-        .triangles
-        .iter()
-        .zip(&piece)
-        .filter(|(_, p)| **p == main)
-        .map(|(t, _)| *t)
-        .collect();
-    TriMesh::new(mesh.vertices, triangles)
+    mesh.keeping_piece(&piece, main)
 }
 
 /// Vertices on the open boundary.

@@ -323,8 +323,24 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
         }
     }
     let mut repairs = Repairs::default();
-    let crown = repair::clean(world, limits, &mut repairs)?;
-    // The span of the tooth itself, loose pieces dropped: wrong units show here.
+    let crown = clean_tooth(world, limits, &mut repairs)?;
+    let close::Closed { mesh, cervical } =
+        close::close(crown, fdi, an.root_length, limits, &mut repairs)?;
+    Ok(Prepared {
+        mesh,
+        cervical,
+        repairs,
+    })
+}
+
+/// The tooth's surface cleaned ([`repair::clean`]) and its span checked: the span of the tooth
+/// itself, loose pieces dropped, is where wrong units show.
+fn clean_tooth(
+    world: &TriMesh,
+    limits: &RepairLimits,
+    repairs: &mut Repairs,
+) -> Result<TriMesh, ImportError> {
+    let crown = repair::clean(world, limits, repairs)?;
     let span = repair::used_span(&crown);
     if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
         return Err(ImportError::Span {
@@ -333,13 +349,7 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
             max_mm: MAX_SPAN_MM,
         });
     }
-    let close::Closed { mesh, cervical } =
-        close::close(crown, fdi, an.root_length, limits, &mut repairs)?;
-    Ok(Prepared {
-        mesh,
-        cervical,
-        repairs,
-    })
+    Ok(crown)
 }
 
 /// [`prepare`], and when the repair cannot make a valid solid, the tooth [`rebuild`]t instead.

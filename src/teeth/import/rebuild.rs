@@ -23,7 +23,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::{
-    MARGIN_COS, MAX_SPAN_MM, MIN_SPAN_MM, Prepared,
+    MARGIN_COS, Prepared,
     close::MARGIN_SPAN,
     error::ImportError,
     fill::fill_hole,
@@ -81,15 +81,7 @@ pub fn rebuild(
         debris_fraction: 1.0,
         ..*limits
     };
-    let crown = repair::clean(world, &lenient, &mut repairs)?;
-    let span = repair::used_span(&crown);
-    if !(MIN_SPAN_MM..=MAX_SPAN_MM).contains(&span) {
-        return Err(ImportError::Span {
-            span_mm: span,
-            min_mm: MIN_SPAN_MM,
-            max_mm: MAX_SPAN_MM,
-        });
-    }
+    let crown = super::clean_tooth(world, &lenient, &mut repairs)?;
     let (closed, cervical) = close_leniently(&crown, fdi, limits, &mut repairs)?;
     let surface = solid_boundary(&closed, REBUILD_CELL_MM)?;
     let target = closed.vertices.len().max(MIN_REBUILT_VERTICES);
@@ -272,14 +264,7 @@ fn largest_shell(mesh: &TriMesh) -> TriMesh {
     let best = (0..count)
         .max_by(|&a, &b| areas[a].total_cmp(&areas[b]))
         .unwrap_or(0) as u32;
-    let triangles = mesh
-        .triangles
-        .iter()
-        .zip(&piece)
-        .filter(|(_, p)| **p == best)
-        .map(|(t, _)| *t)
-        .collect();
-    TriMesh::new(mesh.vertices.clone(), triangles).without_unused_vertices()
+    mesh.keeping_piece(&piece, best).without_unused_vertices()
 }
 
 /// Mean, 95th percentile and largest distance (mm) from the vertices of `rebuilt` that stand
