@@ -31,7 +31,7 @@ pub struct ExportCaseArgs {
     #[arg(long, value_enum, requires = "scan_like")]
     pub labelled: Option<LabelledFormat>,
     /// With `--labelled`: labels that fail as real segmentations' do: labels run into the gum,
-    /// fragments of a tooth's label on its neighbour, islands on the gum, and central incisors
+    /// fragments of a tooth's label on its neighbour, islands on the gum, lower incisors with deep scallops, and central incisors
     /// whose surface crosses itself (see `inspect` for what the import makes of them).
     #[arg(long, requires = "labelled")]
     pub faults: bool,

@@ -15,7 +15,7 @@ use glam::{Quat, Vec3};
 
 use super::{
     Dentition,
-    fdi::{Arch, Fdi},
+    fdi::{Arch, Fdi, ToothKind},
     import::Units,
     scan_like::{ScanDefects, scan_like_crown},
 };
@@ -98,6 +98,9 @@ pub struct LabelFaults {
     pub fragments: usize,
     /// Islands: a few gum triangles labelled with a nearby tooth.
     pub islands: usize,
+    /// Lower incisors whose gum line is scalloped 4–6.5 mm deep (high papillae on a thin crown,
+    /// so a long, steep neck and a margin that folds seen from the root).
+    pub steep_necks: usize,
     /// Thin incisors (then other teeth, lower arch first in a lower scan) whose incisal half is
     /// turned through the rest of the crown, so the surface crosses itself more than the repair
     /// can usually cut out.
@@ -110,6 +113,7 @@ impl LabelFaults {
         gum_bleed: 0,
         fragments: 0,
         islands: 0,
+        steep_necks: 0,
         crossed: 0,
     };
 
@@ -118,6 +122,7 @@ impl LabelFaults {
         gum_bleed: 3,
         fragments: 3,
         islands: 3,
+        steep_necks: 4,
         crossed: 2,
     };
 }
@@ -133,18 +138,21 @@ pub fn labelled_arch_with(
     let mut rng = Rng(seed.wrapping_mul(0xA24B_AED4_963E_E407) | 1);
     let teeth: Vec<_> = d.visible().filter(|t| t.fdi.arch() == arch).collect();
     let mut crowns: Vec<(u32, TriMesh, Vec<u32>)> = Vec::new();
+    let mut steep = faults.steep_necks;
     for t in &teeth {
         let s = seed
             .wrapping_mul(100)
             .wrapping_add(u64::from(t.fdi.number()));
-        let crown = scan_like_crown(
-            arch,
+        let mut defects = ScanDefects::typical(s);
+        let incisor = matches!(
             t.fdi.kind(),
-            &t.pose,
-            triangles,
-            &ScanDefects::typical(s),
-            s,
+            ToothKind::CentralIncisor | ToothKind::LateralIncisor
         );
+        if steep > 0 && arch == Arch::Lower && incisor {
+            steep -= 1;
+            defects.scallop_mm = 4.0 + 2.5 * rng.uniform();
+        }
+        let crown = scan_like_crown(arch, t.fdi.kind(), &t.pose, triangles, &defects, s);
         let n = u32::from(t.fdi.number());
         let labels = vec![n; crown.mesh.vertices.len()];
         crowns.push((n, crown.mesh, labels));

@@ -10,7 +10,9 @@
 //! [`trim_bleed`] works on one tooth once the scan is placed in orthosim's frame, where the
 //! arrangement says which way is occlusal: triangles further below the crown's tip than the
 //! anatomy's crown length allows ([`BLEED_HEIGHT`]), or further from the crown's axis than its
-//! widest dimension allows ([`BLEED_WIDTH`]), are gum or a neighbour's margin, and are trimmed.
+//! widest dimension allows ([`BLEED_WIDTH`]; at the neck, below [`BLEED_NECK`] crown lengths,
+//! the cervix's), are gum or a neighbour's margin, and are trimmed when they hang from the
+//! margin.
 
 use std::collections::HashMap;
 
@@ -29,8 +31,12 @@ pub const BLEED_HEIGHT: f32 = 1.3;
 /// A crown reaches at most this many times half its widest anatomical dimension from its axis
 /// (plus [`BLEED_SLACK_MM`]).
 pub const BLEED_WIDTH: f32 = 1.35;
-/// Slack (mm) on both limits.
+/// Slack (mm) on both limits (twice this at the neck, where the arrangement's axis and the
+/// tooth's may part most).
 pub const BLEED_SLACK_MM: f32 = 0.75;
+/// Below this many crown lengths under the tip, the crown's limit is its cervix's widest
+/// dimension rather than its crown's.
+pub const BLEED_NECK: f32 = 0.6;
 
 /// One change to a scan's labels.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -243,11 +249,22 @@ pub fn trim_bleed(
         return (mesh.clone(), None);
     }
     let axis = upper.iter().copied().sum::<Vec3>() / upper.len() as f32;
+    // The crown is widest at its contacts and narrows to the cervix: below the upper part the
+    // limit is the cervix's.
     let reach = 0.5 * BLEED_WIDTH * an.mesiodistal.max(an.buccolingual) + BLEED_SLACK_MM;
+    let neck = tip - BLEED_NECK * an.crown_length;
+    let reach_neck = 0.5 * BLEED_WIDTH * an.mesiodistal_cervix.max(an.buccolingual_cervix)
+        + 2.0 * BLEED_SLACK_MM;
     let past = |p: Vec3| {
         let d = p - axis;
         let across = d - occlusal * d.dot(occlusal);
-        p.dot(occlusal) < floor || across.length() > reach
+        let height = p.dot(occlusal);
+        let limit = if height < neck {
+            reach_neck.min(reach)
+        } else {
+            reach
+        };
+        height < floor || across.length() > limit
     };
     let mut kept = Vec::with_capacity(mesh.triangles.len());
     let (mut cut, mut sum) = (0usize, Vec3::ZERO);
