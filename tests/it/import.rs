@@ -427,3 +427,35 @@ fn bad_mesh_files_fail_naming_the_file_and_tooth() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_tooth_file_the_repair_refuses_is_rebuilt_in_a_case() {
+    // The crown turned sideways through the root, as in the refusal test: `import_mesh` refuses
+    // it, while a case naming the file imports it rebuilt, near where the file has it.
+    let d = normal();
+    let (mesh, _, _) = world_tooth(&d, 36);
+    let c = mesh.aabb().centre();
+    let turn = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let m = mesh.map_vertices(|v| if v.y > c.y { c + turn * (v - c) } else { v });
+    assert!(import(&m, 36).is_err());
+    let dir = temp_dir("rebuilt");
+    let mut file = std::fs::File::create(dir.join("36.stl")).unwrap();
+    orthosim::teeth::import::write_stl(&m, &mut file).unwrap();
+    drop(file);
+    let case = dir.join("case.ron");
+    std::fs::write(
+        &case,
+        r#"Case(name: "rebuilt", meshes: {36: (file: "36.stl", transform: Identity)})"#,
+    )
+    .unwrap();
+    let built = Dentition::build(Case::load(&case).unwrap()).unwrap();
+    let repairs = &built.imported[&Fdi::new(36).unwrap()];
+    let r = repairs.rebuilt.as_ref().expect("rebuilt");
+    assert!(r.reason.contains("intersects itself"), "{r:?}");
+    assert!(r.mean_mm <= 0.05, "{r:?}");
+    let t = built.tooth(Fdi::new(36).unwrap()).unwrap();
+    t.geometry.mesh.validate_solid().unwrap();
+    let volume = t.geometry.mesh.signed_volume();
+    assert!(volume > 0.5 * m.signed_volume().abs(), "{volume}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -365,7 +365,7 @@ pub fn prepare_or_rebuild(
     match prepare(world, fdi, limits) {
         Ok(p) => Ok(p),
         Err(e) if !e.is_repairable() => Err(e),
-        Err(e) => rebuild(world, fdi, limits, &e),
+        Err(e) => rebuild(world, fdi, limits, &e).map_err(|_| e),
     }
 }
 
