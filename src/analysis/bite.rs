@@ -317,41 +317,45 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
         .fold(0.0f32, f32::max) as f64;
     // The hinge: turning by φ about the axis through the seated condyles (positive opens).
     let right = condyle_seat(-1.0);
-    let hinge = |phi: f32| {
-        let q = Quat::from_axis_angle(Vec3::X, phi);
-        Pose::new(q, right - q * right)
-    };
+    let hinge = |phi: f32| Pose::turn_about(right, Quat::from_axis_angle(Vec3::X, phi));
     let from_hinge = |p: Vec3| Vec2::new(p.y - right.y, p.z - right.z).length();
     let incisal = lower_points()
         .max_by(|a, b| a.z.total_cmp(&b.z))
         .unwrap_or(centre);
     let mut moved = Pose::IDENTITY;
     let mut opened_mm = 0.0;
+    let listed = |moved: &Pose| {
+        let mut pairs = Tracker::boxed(teeth, moved, opening_mm.max(0.0) + 3.0);
+        pairs.refresh_within(moved, f32::INFINITY, SETTLE_LIMIT_MM);
+        pairs
+    };
     if settle {
         moved = hinge(opening_mm.max(0.0) / from_hinge(centre).max(1.0));
-        // Interpenetrating arches are opened along the hinge until every pair is clear.
+    }
+    let mut pairs = listed(&moved);
+    // Interpenetrating arches are opened along the hinge until every pair is clear.
+    if settle && pairs.least_measured() < TARGET_GAP_MM {
         let least_at = |phi: f32| {
             let pose = hinge(phi).mul(&moved);
             let mut pairs = Tracker::boxed(teeth, &pose, 0.0);
             pairs.refresh_within(&pose, f32::INFINITY, TARGET_GAP_MM);
             pairs.least_measured()
         };
-        if least_at(0.0) < TARGET_GAP_MM {
-            let (mut shut, mut open) = (0.0f32, 0.25f32.to_radians());
-            while least_at(open) < TARGET_GAP_MM && open < 20f32.to_radians() {
-                (shut, open) = (open, 2.0 * open);
-            }
-            for _ in 0..24 {
-                let mid = 0.5 * (shut + open);
-                if least_at(mid) < TARGET_GAP_MM {
-                    shut = mid;
-                } else {
-                    open = mid;
-                }
-            }
-            moved = hinge(open).mul(&moved);
-            opened_mm = open * from_hinge(incisal);
+        let (mut shut, mut open) = (0.0f32, 0.25f32.to_radians());
+        while least_at(open) < TARGET_GAP_MM && open < 20f32.to_radians() {
+            (shut, open) = (open, 2.0 * open);
         }
+        for _ in 0..24 {
+            let mid = 0.5 * (shut + open);
+            if least_at(mid) < TARGET_GAP_MM {
+                shut = mid;
+            } else {
+                open = mid;
+            }
+        }
+        moved = hinge(open).mul(&moved);
+        opened_mm = open * from_hinge(incisal);
+        pairs = listed(&moved);
     }
     let mut iterations = 0;
     let mut why = None;
@@ -372,8 +376,6 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
     };
     let travel_limit = opening_mm.max(0.0) + 10.0;
     let start = moved.transform_point(centre);
-    let mut pairs = Tracker::boxed(teeth, &moved, opening_mm.max(0.0) + 3.0);
-    pairs.refresh_within(&moved, f32::INFINITY, SETTLE_LIMIT_MM);
     loop {
         pairs.refresh_within(&moved, 2.0 * CONTACT_MM, SETTLE_LIMIT_MM);
         let c = moved.transform_point(centre).as_dvec3();

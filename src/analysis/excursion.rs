@@ -32,7 +32,7 @@ use glam::{Quat, Vec3};
 use serde::Serialize;
 
 use super::{
-    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, Tracker},
+    bite::{AREA_TOLERANCE_MM, TARGET_GAP_MM, Tracker, condyle_seat},
     measures::Posed,
 };
 use crate::{
@@ -125,13 +125,7 @@ fn anterior(f: Fdi) -> bool {
 /// `bite` (relative to where the case placed it).
 pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> Excursion {
     let tan = CONDYLAR_GUIDANCE_DEG.to_radians().tan();
-    let condyle = |s: f32| {
-        Vec3::new(
-            s * CONDYLE_HALF_WIDTH_MM,
-            CONDYLE_ABOVE_MM,
-            -CONDYLE_BEHIND_MM,
-        )
-    };
+    let condyle = condyle_seat;
     let incisal = Vec3::new(0.0, 0.0, 20.0);
     let lower = |t: &Posed| t.fdi.arch() == crate::teeth::Arch::Lower;
     // Each lower tooth's vertices at the bite, and which of them each tooth is.
@@ -184,11 +178,11 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
                 // anteroposterior line through the working condyle.
                 let working = condyle(s);
                 let spin = Quat::from_rotation_y(s * h / (incisal.z - working.z));
-                let turn = Pose::new(spin, working - spin * working);
+                let turn = Pose::turn_about(working, spin);
                 let forward = turn.transform_point(condyle(-s)).z - condyle(-s).z;
                 let drop = forward.max(0.0) * tan;
                 let tilt = Quat::from_rotation_z(s * (drop / (2.0 * CONDYLE_HALF_WIDTH_MM)).atan());
-                let slide = Pose::new(tilt, working - tilt * working).mul(&turn);
+                let slide = Pose::turn_about(working, tilt).mul(&turn);
                 (
                     slide,
                     slide.transform_point(condyle(1.0)),
@@ -199,8 +193,9 @@ pub fn excursion(teeth: &[Posed], bite: &Pose, kind: ExcursionKind, mm: f32) -> 
         let axis = (left - right).normalize();
         // Closing turns the front of the arch up: about +x through the condyles.
         let close = |phi: f32| {
-            let q = Quat::from_axis_angle(axis, -phi);
-            Pose::new(q, right - q * right).mul(&slide).mul(bite)
+            Pose::turn_about(right, Quat::from_axis_angle(axis, -phi))
+                .mul(&slide)
+                .mul(bite)
         };
         // How far each lower tooth's points lie from the hinge axis (1 mm spare): bounds their
         // speed per radian, so a pair's gap shrinks by at most its lower tooth's reach per radian

@@ -39,6 +39,11 @@ impl Pose {
         Self::new(Quat::IDENTITY, translation)
     }
 
+    /// The turn `rotation` about the point `pivot` (which stays where it is).
+    pub fn turn_about(pivot: Vec3, rotation: Quat) -> Self {
+        Self::new(rotation, pivot - rotation * pivot)
+    }
+
     /// Maps a point from the local frame to the world frame.
     #[inline]
     pub fn transform_point(&self, p: Vec3) -> Vec3 {

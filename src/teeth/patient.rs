@@ -184,30 +184,24 @@ pub(super) fn patient_teeth(
             }
         }
     }
-    // Labels past the crown trimmed, where the arrangement says which way is occlusal.
-    let mut trims: Vec<Option<LabelFix>> = vec![None; sources.len()];
-    let mut worlds: Vec<TriMesh> = Vec::with_capacity(sources.len());
-    for (i, s) in sources.iter().enumerate() {
-        let world = s.mesh.map_vertices(|v| poses[i].transform_point(v));
-        if s.scanned {
-            let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
-            let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
-            let (trimmed, fix) = trim_bleed(&world, s.fdi, &an, occlusal);
-            trims[i] = fix;
-            worlds.push(trimmed);
-        } else {
-            worlds.push(world);
-        }
-    }
-    // Repair and close (or rebuild), on all cores.
+    // Labels past the crown trimmed (where the arrangement says which way is occlusal), then
+    // repaired and closed or rebuilt, on all cores.
     let jobs: Vec<usize> = (0..sources.len()).collect();
     let limits = RepairLimits::default();
     let prepared = crate::parallel::parallel_map(&jobs, |&i| {
-        prepare_or_rebuild(&worlds[i], sources[i].fdi, &limits)
+        let s = &sources[i];
+        let world = s.mesh.map_vertices(|v| poses[i].transform_point(v));
+        if !s.scanned {
+            return (None, prepare_or_rebuild(&world, s.fdi, &limits));
+        }
+        let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
+        let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
+        let (trimmed, fix) = trim_bleed(&world, s.fdi, &an, occlusal);
+        (fix, prepare_or_rebuild(&trimmed, s.fdi, &limits))
     });
     let mut teeth = Vec::with_capacity(sources.len());
     let mut kept = Vec::with_capacity(labelled.len());
-    for ((s, p), trim) in sources.iter().zip(prepared).zip(trims) {
+    for (s, (trim, p)) in sources.iter().zip(prepared) {
         let report = scans.iter_mut().find(|r| r.file == s.file && s.scanned);
         if let (Some(r), Some(fix)) = (report, trim) {
             r.fixes.push(fix);
