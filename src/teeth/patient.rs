@@ -11,7 +11,9 @@ use super::{
     case::{Case, CaseError, LoadedCase},
     fdi::Fdi,
     import::{
-        ImportError, LabelFix, Placement, Prepared, RepairLimits, check_raw, check_scan,
+        ImportError, LabelFix, Placement, Prepared, RepairLimits, RootGuide,
+        apart::keep_roots_apart,
+        check_raw, check_scan,
         orient::{Arranged, REFERENCE_RESOLUTION, as_euler_deg, orient},
         prepare_or_rebuild, read_in_mm, read_labelled, split, tidy_labels, trim_bleed,
     },
@@ -188,17 +190,38 @@ pub(super) fn patient_teeth(
     // repaired and closed or rebuilt, on all cores.
     let jobs: Vec<usize> = (0..sources.len()).collect();
     let limits = RepairLimits::default();
-    let prepared = crate::parallel::parallel_map(&jobs, |&i| {
+    let mut guides: Vec<RootGuide> = sources
+        .iter()
+        .map(|s| RootGuide {
+            guess: Some(arrangement.pose(s.fdi)),
+            ..RootGuide::default()
+        })
+        .collect();
+    let first = crate::parallel::parallel_map(&jobs, |&i| {
         let s = &sources[i];
         let world = s.mesh.map_vertices(|v| poses[i].transform_point(v));
-        if !s.scanned {
-            return (None, prepare_or_rebuild(&world, s.fdi, &limits));
-        }
-        let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
-        let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
-        let (trimmed, fix) = trim_bleed(&world, s.fdi, &an, occlusal);
-        (fix, prepare_or_rebuild(&trimmed, s.fdi, &limits))
+        let (input, fix) = if s.scanned {
+            let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
+            let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
+            trim_bleed(&world, s.fdi, &an, occlusal)
+        } else {
+            (world, None)
+        };
+        let p = prepare_or_rebuild(&input, s.fdi, &limits, guides[i]);
+        (fix, input, p)
     });
+    let mut trims = Vec::with_capacity(first.len());
+    let mut inputs = Vec::with_capacity(first.len());
+    let mut results = Vec::with_capacity(first.len());
+    for (fix, input, p) in first {
+        trims.push(fix);
+        inputs.push(input);
+        results.push(p);
+    }
+    // Generated roots of neighbouring crowns turned apart where they reach into each other.
+    let fdis: Vec<Fdi> = sources.iter().map(|s| s.fdi).collect();
+    keep_roots_apart(&fdis, &inputs, &mut results, &mut guides, &limits);
+    let prepared = trims.into_iter().zip(results);
     let mut teeth = Vec::with_capacity(sources.len());
     let mut kept = Vec::with_capacity(labelled.len());
     for (s, (trim, p)) in sources.iter().zip(prepared) {

@@ -187,6 +187,17 @@ fn labelled_scans_in_every_format_import_without_a_hand_written_transform() {
                 t.fdi
             );
         }
+        // Every crown got its template root, and no two teeth of an arch start inside each
+        // other by more than 0.05 mm (crowns touching as scanned, roots apart).
+        for (fdi, r) in &imported.imported {
+            let root = r.root.as_ref().unwrap_or_else(|| panic!("{fdi}: no root"));
+            assert_eq!(root.kind, "template", "{format:?} {fdi}: {root:?}");
+        }
+        let inspected = orthosim::analysis::inspect::inspect(&imported);
+        for g in &inspected.neighbour_gaps_mm {
+            assert!(g.gap_mm > -0.05, "{format:?}: {}-{} {}", g.a, g.b, g.gap_mm);
+        }
+        assert!(inspected.max_penetration_mm < 0.05, "{format:?}");
         // The placement found is the scanner frame's inverse.
         let truth = frame.pose.inverse();
         let [rx, ry, rz] = o[0].rotation_deg;

@@ -15,6 +15,7 @@ mod occlusion_measures;
 mod oracle;
 mod parry_support;
 mod pdl;
+mod roots;
 mod scans;
 mod schedule;
 mod stress;

@@ -18,8 +18,9 @@ use super::{
     error::{ImportError, Near},
     fill::fill_hole,
     occlusal_direction,
-    repair::{self, RepairLimits, Repairs},
+    repair::{self, RepairLimits, Repairs, RootReport},
     root,
+    template::{self, Template},
 };
 use crate::geometry::{MeshError, TriMesh};
 use crate::teeth::fdi::Fdi;
@@ -46,6 +47,22 @@ pub(super) struct Closed {
     pub mesh: TriMesh,
     /// The margin's centroid, when a root was generated.
     pub cervical: Option<Vec3>,
+    /// The root's apical direction (unit), when a root was generated.
+    pub apical: Option<Vec3>,
+}
+
+/// Farthest (mm, root mean square) a crown may lie from its fitted template for the template's
+/// root to be used.
+pub const MAX_FIT_RMS_MM: f32 = 1.0;
+
+/// Which root a scanned crown gets.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum RootChoice {
+    /// The tooth type's template fitted to the crown, starting from the tooth's pose in the
+    /// arrangement when known, then turned and shortened as the guide says.
+    Template(super::RootGuide),
+    /// A cone along the margin's normal.
+    Cone,
 }
 
 /// Closes `crown` (clean, consistently wound, possibly open) into a solid.
@@ -55,7 +72,10 @@ pub(super) fn close(
     root_length: f32,
     limits: &RepairLimits,
     repairs: &mut Repairs,
+    choice: RootChoice,
 ) -> Result<Closed, ImportError> {
+    // The template and its fit, once the margin is known (None: the cone, and why).
+    let mut fitted: Option<Result<(std::sync::Arc<Template>, template::Fit), String>> = None;
     let budget = (limits.max_cut_fraction * crown.triangles.len() as f32) as usize;
     let (mut trims, mut round) = (0, 0);
     loop {
@@ -79,7 +99,7 @@ pub(super) fn close(
             }
         }
         if let Some(m) = margin {
-            let (_, apical) = root::margin_axis(&base, &loops[m])?;
+            let (centre, apical) = root::margin_axis(&base, &loops[m])?;
             if apical.dot(-occlusal_direction(fdi.arch())) < MARGIN_COS {
                 return Err(ImportError::OpenNotMargin {
                     length_mm: lengths[m],
@@ -87,16 +107,36 @@ pub(super) fn close(
                     max_hole_mm: limits.max_hole_mm,
                 });
             }
+            if fitted.is_none() {
+                fitted = Some(match choice {
+                    RootChoice::Cone => Err("the cone was asked for".into()),
+                    RootChoice::Template(guide) => {
+                        let t = Template::of(fdi.arch(), fdi.kind());
+                        match template::fit(&base, fdi, guide.guess, centre, apical) {
+                            Some(f) if f.rms_mm <= MAX_FIT_RMS_MM => Ok((t, guide.applied_to(f))),
+                            Some(f) => Err(format!(
+                                "the crown lies {:.2} mm (rms) from its template, more than {MAX_FIT_RMS_MM} mm",
+                                f.rms_mm
+                            )),
+                            None => Err("too few vertices to fit a template".into()),
+                        }
+                    }
+                });
+            }
         }
+        let guide = fitted.as_ref().and_then(|f| f.as_ref().ok());
         // A margin that folds over itself seen from the root's side (a jagged gum line on a
         // steep wall) loses the triangles hanging at the folds first, while rounds remain.
         if let Some(m) = margin
             && trims < MAX_TRIMS
         {
-            let at: HashSet<u32> = root::tangles(&base, &loops[m], root_length)?
-                .into_iter()
-                .map(|k| loops[m][k])
-                .collect();
+            let folds = match guide {
+                Some((t, f)) => {
+                    root::tangles_along(&base, &loops[m], f.origin, f.apical(), f.root_length(t))
+                }
+                None => root::tangles(&base, &loops[m], root_length)?,
+            };
+            let at: HashSet<u32> = folds.into_iter().map(|k| loops[m][k]).collect();
             if !at.is_empty() {
                 let cut: HashSet<usize> = (0..crown.triangles.len())
                     .filter(|&t| crown.triangles[t].iter().any(|v| at.contains(v)))
@@ -117,9 +157,41 @@ pub(super) fn close(
         let mut fewest: Option<(TriMesh, Vec<(usize, usize)>)> = None;
         for &gap in gaps {
             let mut mesh = base.clone();
-            let cervical = match margin {
-                Some(m) => Some(root::close_with_root(&mut mesh, &loops[m], root_length, gap)?.0),
-                None => None,
+            let (cervical, root, apical) = match (margin, guide) {
+                (Some(m), Some((t, f))) => {
+                    let r = root::close_with_template(&mut mesh, &loops[m], gap, t, f)?;
+                    let (tilt_deg, shortened_mm) = match choice {
+                        RootChoice::Template(g) => (
+                            g.tilt.length().to_degrees(),
+                            g.shorten * t.anatomy.root_length,
+                        ),
+                        RootChoice::Cone => (0.0, 0.0),
+                    };
+                    let report = RootReport {
+                        kind: "template",
+                        length_mm: r.length_mm,
+                        axis_deg: r.axis_deg,
+                        fit_rms_mm: Some(f.rms_mm),
+                        tilt_deg,
+                        shortened_mm,
+                        fallback: None,
+                    };
+                    (Some(r.cervical), Some(report), Some(f.apical()))
+                }
+                (Some(m), None) => {
+                    let (c, a) = root::close_with_root(&mut mesh, &loops[m], root_length, gap)?;
+                    let report = RootReport {
+                        kind: "cone",
+                        length_mm: root_length,
+                        axis_deg: root::LEAN_RAD.to_degrees() as f32,
+                        fit_rms_mm: None,
+                        tilt_deg: 0.0,
+                        shortened_mm: 0.0,
+                        fallback: fitted.as_ref().and_then(|f| f.as_ref().err().cloned()),
+                    };
+                    (Some(c), Some(report), Some(a))
+                }
+                _ => (None, None, None),
             };
             if mesh.signed_volume() < 0.0 {
                 for t in &mut mesh.triangles {
@@ -134,9 +206,11 @@ pub(super) fn close(
             if pairs.is_empty() {
                 repairs.holes_closed_mm.extend(holes);
                 repairs.root_generated_margin_mm = margin.map(|m| lengths[m]);
+                repairs.root = root;
                 return Ok(Closed {
                     mesh: mesh.without_unused_vertices(),
                     cervical,
+                    apical,
                 });
             }
             if fewest.as_ref().is_none_or(|(_, p)| pairs.len() < p.len()) {

@@ -29,6 +29,7 @@
 //! So loads, wire models, constraints and the analysis work on imported teeth as on procedural
 //! ones; the tooth stands exactly where the scan has it (its pose maps the local mesh back).
 
+pub mod apart;
 mod close;
 mod error;
 mod export;
@@ -41,6 +42,7 @@ pub mod rebuild;
 pub mod repair;
 pub mod root;
 pub mod segments;
+pub mod template;
 
 use std::path::Path;
 
@@ -64,7 +66,7 @@ pub use export::{
 pub use labels::{LabelledMesh, Labels, check_raw, check_scan, read_labelled, split};
 pub use read::{MeshFormat, read_mesh, write_stl};
 pub use rebuild::{Rebuilt, rebuild};
-pub use repair::{RepairLimits, Repairs};
+pub use repair::{RepairLimits, Repairs, RootReport};
 pub use segments::{LabelFix, tidy_labels, trim_bleed};
 
 /// Units of a mesh file.
@@ -300,6 +302,8 @@ pub struct Prepared {
     pub mesh: TriMesh,
     /// The centroid of the cervical margin, for a scanned crown.
     pub cervical: Option<Vec3>,
+    /// The generated root's apical direction (unit), for a scanned crown.
+    pub apical: Option<Vec3>,
     /// What was repaired.
     pub repairs: Repairs,
 }
@@ -310,6 +314,42 @@ pub struct Prepared {
 /// # Errors
 /// What is wrong and where ([`ImportError`]).
 pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepared, ImportError> {
+    prepare_guided(world, fdi, limits, RootGuide::default())
+}
+
+/// How a scanned crown's template root is placed: where the fit starts, and how the fitted root
+/// is then turned and shortened (to keep it out of its neighbours' roots).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RootGuide {
+    /// The pose of the tooth's local frame in the arrangement, where the fit starts (it also
+    /// starts from the crown's margin).
+    pub guess: Option<Pose>,
+    /// A turn (rotation vector, radians, world) of the root about its cervical centre.
+    pub tilt: Vec3,
+    /// Share of the template's root length taken off (0–1).
+    pub shorten: f32,
+}
+
+impl RootGuide {
+    /// The fit turned and shortened as this guide says.
+    pub(super) fn applied_to(&self, mut fit: template::Fit) -> template::Fit {
+        fit.rotation = (Quat::from_scaled_axis(self.tilt) * fit.rotation).normalize();
+        fit.scale.y *= 1.0 - self.shorten.clamp(0.0, 0.9);
+        fit
+    }
+}
+
+/// [`prepare`], a scanned crown's template root fitted and placed as `guide` says. A crown whose
+/// template root cannot be closed gets the cone root, and the report says why.
+///
+/// # Errors
+/// What is wrong and where ([`ImportError`]).
+pub fn prepare_guided(
+    world: &TriMesh,
+    fdi: Fdi,
+    limits: &RepairLimits,
+    guide: RootGuide,
+) -> Result<Prepared, ImportError> {
     let an = anatomy(fdi.arch(), fdi.kind());
     // Absurd sizes (far beyond any unit mix-up with debris) are refused before any repair.
     if world.vertices.iter().all(|v| v.is_finite()) && !world.vertices.is_empty() {
@@ -324,11 +364,41 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
     }
     let mut repairs = Repairs::default();
     let crown = clean_tooth(world, limits, &mut repairs)?;
-    let close::Closed { mesh, cervical } =
-        close::close(crown, fdi, an.root_length, limits, &mut repairs)?;
+    let cleaned = repairs.clone();
+    let template = close::RootChoice::Template(guide);
+    let close::Closed {
+        mesh,
+        cervical,
+        apical,
+    } = match close::close(
+        crown.clone(),
+        fdi,
+        an.root_length,
+        limits,
+        &mut repairs,
+        template,
+    ) {
+        Ok(c) => c,
+        Err(e) => {
+            repairs = cleaned;
+            let c = close::close(
+                crown,
+                fdi,
+                an.root_length,
+                limits,
+                &mut repairs,
+                close::RootChoice::Cone,
+            )?;
+            if let Some(r) = &mut repairs.root {
+                r.fallback = Some(format!("the template root could not be closed: {e}"));
+            }
+            c
+        }
+    };
     Ok(Prepared {
         mesh,
         cervical,
+        apical,
         repairs,
     })
 }
@@ -361,11 +431,12 @@ pub fn prepare_or_rebuild(
     world: &TriMesh,
     fdi: Fdi,
     limits: &RepairLimits,
+    guide: RootGuide,
 ) -> Result<Prepared, ImportError> {
-    match prepare(world, fdi, limits) {
+    match prepare_guided(world, fdi, limits, guide) {
         Ok(p) => Ok(p),
         Err(e) if !e.is_repairable() => Err(e),
-        Err(e) => rebuild(world, fdi, limits, &e).map_err(|_| e),
+        Err(e) => rebuild::rebuild_guided(world, fdi, limits, &e, guide).map_err(|_| e),
     }
 }
 

@@ -28,8 +28,9 @@ use super::{
     error::ImportError,
     fill::fill_hole,
     occlusal_direction,
-    repair::{self, RepairLimits, Repairs},
+    repair::{self, RepairLimits, Repairs, RootReport},
     root,
+    template::{self, Template},
 };
 use crate::geometry::{
     Columns, MeshRef, TriMesh, TriangleBvh, closest_point_on_mesh, closest_point_triangle,
@@ -76,13 +77,27 @@ pub fn rebuild(
     limits: &RepairLimits,
     reason: &ImportError,
 ) -> Result<Prepared, ImportError> {
+    rebuild_guided(world, fdi, limits, reason, super::RootGuide::default())
+}
+
+/// [`rebuild`] with the template root placed as `guide` says (see [`super::prepare_guided`]).
+///
+/// # Errors
+/// As [`rebuild`].
+pub fn rebuild_guided(
+    world: &TriMesh,
+    fdi: Fdi,
+    limits: &RepairLimits,
+    reason: &ImportError,
+    guide: super::RootGuide,
+) -> Result<Prepared, ImportError> {
     let mut repairs = Repairs::default();
     let lenient = RepairLimits {
         debris_fraction: 1.0,
         ..*limits
     };
     let crown = super::clean_tooth(world, &lenient, &mut repairs)?;
-    let (closed, cervical) = close_leniently(&crown, fdi, limits, &mut repairs)?;
+    let (closed, cervical, apical) = close_leniently(&crown, fdi, limits, &mut repairs, guide)?;
     let surface = solid_boundary(&closed, REBUILD_CELL_MM)?;
     let target = closed.vertices.len().max(MIN_REBUILT_VERTICES);
     let simplified = decimate(
@@ -112,18 +127,21 @@ pub fn rebuild(
     Ok(Prepared {
         mesh,
         cervical,
+        apical,
         repairs,
     })
 }
 
 /// The crown's holes filled and its margin given a root, without any check that the result does
-/// not meet itself; its margin's centroid when it has one.
+/// not meet itself; its cervical centre and root's apical direction when it has a margin. The
+/// root is the template's when the template fits the crown, else a cone.
 fn close_leniently(
     crown: &TriMesh,
     fdi: Fdi,
     limits: &RepairLimits,
     repairs: &mut Repairs,
-) -> Result<(TriMesh, Option<Vec3>), ImportError> {
+    guide: super::RootGuide,
+) -> Result<(TriMesh, Option<Vec3>, Option<Vec3>), ImportError> {
     let loops = repair::boundary_loops(crown)?;
     let lengths: Vec<f32> = loops
         .iter()
@@ -140,7 +158,7 @@ fn close_leniently(
             repairs.holes_closed_mm.push(lengths[i]);
         }
     }
-    let mut cervical = None;
+    let (mut cervical, mut axis) = (None, None);
     if let Some(m) = margin {
         let (centre, own) = root::margin_axis(&mesh, &loops[m])?;
         let toward = -occlusal_direction(fdi.arch());
@@ -150,16 +168,51 @@ fn close_leniently(
             own
         };
         let root_length = anatomy(fdi.arch(), fdi.kind()).root_length;
-        root::close_with_root_along(
-            &mut mesh,
-            &loops[m],
-            root_length,
-            root::GAPS_MM[0],
-            centre,
-            apical,
-        );
+        let template = Template::of(fdi.arch(), fdi.kind());
+        let fit = template::fit(&mesh, fdi, guide.guess, centre, apical)
+            .filter(|f| f.rms_mm <= super::close::MAX_FIT_RMS_MM)
+            .map(|f| guide.applied_to(f));
+        let mut templated = mesh.clone();
+        let made = fit.and_then(|f| {
+            root::close_with_template(&mut templated, &loops[m], root::GAPS_MM[0], &template, &f)
+                .ok()
+                .map(|r| (f, r))
+        });
+        if let Some((f, r)) = made {
+            mesh = templated;
+            repairs.root = Some(RootReport {
+                kind: "template",
+                length_mm: r.length_mm,
+                axis_deg: r.axis_deg,
+                fit_rms_mm: Some(f.rms_mm),
+                tilt_deg: guide.tilt.length().to_degrees(),
+                shortened_mm: guide.shorten * template.anatomy.root_length,
+                fallback: None,
+            });
+            cervical = Some(r.cervical);
+            axis = Some(f.apical());
+        } else {
+            root::close_with_root_along(
+                &mut mesh,
+                &loops[m],
+                root_length,
+                root::GAPS_MM[0],
+                centre,
+                apical,
+            );
+            repairs.root = Some(RootReport {
+                kind: "cone",
+                length_mm: root_length,
+                axis_deg: apical.angle_between(own).to_degrees(),
+                fit_rms_mm: fit.map(|f| f.rms_mm),
+                tilt_deg: 0.0,
+                shortened_mm: 0.0,
+                fallback: Some("no template fits the crown".into()),
+            });
+            cervical = Some(centre);
+            axis = Some(apical);
+        }
         repairs.root_generated_margin_mm = Some(lengths[m]);
-        cervical = Some(centre);
     }
     if mesh.signed_volume() < 0.0 {
         for t in &mut mesh.triangles {
@@ -167,7 +220,7 @@ fn close_leniently(
         }
         repairs.turned_outward = true;
     }
-    Ok((mesh, cervical))
+    Ok((mesh, cervical, axis))
 }
 
 /// The boundary of the solid that the closed surface `closed` winds around (see the module doc),

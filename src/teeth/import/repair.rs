@@ -91,6 +91,31 @@ pub struct Repairs {
     /// surface encloses ([`super::rebuild`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rebuilt: Option<super::rebuild::Rebuilt>,
+    /// Which root a scanned crown got, when it got one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub root: Option<RootReport>,
+}
+
+/// The root generated for a scanned crown.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RootReport {
+    /// "template" (the tooth type's procedural root, fitted to the crown) or "cone" (a cone along
+    /// the margin's normal, the fallback).
+    pub kind: &'static str,
+    /// From the cervical centre to the apex (mm).
+    pub length_mm: f32,
+    /// Angle (degrees) between the root's axis and the margin's apical normal.
+    pub axis_deg: f32,
+    /// How far (mm, root mean square) the crown lies from the fitted template's surface.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit_rms_mm: Option<f32>,
+    /// How far (degrees) the root was turned away from its neighbours' roots.
+    pub tilt_deg: f32,
+    /// How much (mm) the root was shortened so that it does not reach into a neighbour's.
+    pub shortened_mm: f32,
+    /// Why the template root was not used, for a cone.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
 }
 
 impl Repairs {
@@ -149,7 +174,24 @@ impl Repairs {
             parts.push("surface turned outward".into());
         }
         if let Some(l) = self.root_generated_margin_mm {
-            parts.push(format!("root generated below a {l:.1} mm cervical margin"));
+            let root = match &self.root {
+                Some(r) if r.kind == "template" => format!(
+                    "template root ({:.1} mm, {:.0}° from the margin's normal)",
+                    r.length_mm, r.axis_deg
+                ),
+                Some(r) => format!(
+                    "cone root ({:.1} mm{})",
+                    r.length_mm,
+                    r.fallback
+                        .as_deref()
+                        .map(|f| format!("; no template root: {f}"))
+                        .unwrap_or_default()
+                ),
+                None => "root".into(),
+            };
+            parts.push(format!(
+                "{root} generated below a {l:.1} mm cervical margin"
+            ));
         }
         if let Some(r) = &self.rebuilt {
             parts.push(format!(
