@@ -36,6 +36,10 @@ pub struct ToothReport {
     pub crown_centre: [f32; 3],
     /// Extracted tooth.
     pub extracted: bool,
+    /// The root generated for a scanned crown: which kind, its length and its axis's angle to the
+    /// margin's normal.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub root: Option<crate::teeth::import::RootReport>,
 }
 
 /// The exact gap between two adjacent teeth.
@@ -132,6 +136,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
                 volume_mm3: t.geometry.frame.volume_mm3,
                 crown_centre: t.crown_centre().to_array(),
                 extracted: t.extracted,
+                root: d.imported.get(&t.fdi).and_then(|r| r.root.clone()),
             }
         })
         .collect();

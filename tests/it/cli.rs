@@ -974,6 +974,12 @@ fn a_scan_like_export_imports_and_runs_through_inspect_trees_and_simulate() {
     }
     for t in report["teeth"].as_array().unwrap() {
         assert_eq!(t["closed"], true, "{t}");
+        // Each crown's root is its tooth type's template, along the template's axis.
+        let root = &t["root"];
+        assert_eq!(root["kind"], "template", "{t}");
+        let length = root["length_mm"].as_f64().unwrap();
+        assert!((10.0..18.0).contains(&length), "{t}");
+        assert!(root["axis_deg"].as_f64().unwrap() < 45.0, "{t}");
     }
     // The occlusion is measured on the scanned teeth.
     assert!(report["occlusion"]["molar_relation_mm"].is_number());

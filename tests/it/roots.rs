@@ -3,13 +3,15 @@
 
 use glam::{Quat, Vec3};
 use orthosim::{
-    geometry::Pose,
+    geometry::{MeshRef, Pose, TriangleBvh, mesh_separation},
     prelude::*,
     teeth::{
         Dentition,
         anatomy::anatomy,
         arch::ArchCurve,
-        import::{RepairLimits, RootGuide, prepare_guided},
+        import::{
+            ImportError, Prepared, RepairLimits, RootGuide, apart::keep_roots_apart, prepare_guided,
+        },
         scan_like::{ScanDefects, scan_like_crown},
     },
 };
@@ -83,6 +85,98 @@ fn scan_like_crowns_get_roots_along_the_true_axis_of_the_true_length() {
                 "{n}: centre of resistance {} mm off",
                 cr.distance(true_cr)
             );
+        }
+    }
+}
+
+#[test]
+fn roots_that_start_crossing_are_turned_apart() {
+    // Lower central and lateral incisors, crowns where the normal case has them, roots turned 12°
+    // towards the midline: the central incisors' roots cross. Turning them apart leaves no pair
+    // more than 0.05 mm inside another, and each turned tooth reports its turn.
+    let d = normal();
+    let limits = RepairLimits::default();
+    let fdis: Vec<Fdi> = [42, 41, 31, 32].map(|n| Fdi::new(n).unwrap()).to_vec();
+    let inputs: Vec<_> = fdis
+        .iter()
+        .enumerate()
+        .map(|(i, &f)| {
+            let tooth = d.tooth(f).unwrap();
+            scan_like_crown(
+                f.arch(),
+                f.kind(),
+                &tooth.pose,
+                1200,
+                &ScanDefects::CLEAN,
+                20 + i as u64,
+            )
+            .mesh
+        })
+        .collect();
+    let mut guides: Vec<RootGuide> = fdis
+        .iter()
+        .map(|&f| {
+            let tooth = d.tooth(f).unwrap();
+            // Apex towards the midline (x = 0): about the tooth's buccal axis.
+            let buccal = tooth.pose.rotation * Vec3::Z;
+            let toward = if tooth.pose.translation.x > 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            let turn = if f.kind() == ToothKind::CentralIncisor {
+                9f32
+            } else {
+                0.0
+            };
+            RootGuide {
+                guess: Some(tooth.pose),
+                tilt: buccal * toward * turn.to_radians(),
+                shorten: 0.0,
+            }
+        })
+        .collect();
+    let mut results: Vec<_> = fdis
+        .iter()
+        .zip(&inputs)
+        .zip(&guides)
+        .map(|((&f, m), g)| prepare_guided(m, f, &limits, *g))
+        .collect();
+    let deepest = |results: &[Result<Prepared, ImportError>]| {
+        let mut worst = 0.0f32;
+        for i in 0..results.len() {
+            for j in i + 1..results.len() {
+                let (a, b) = (results[i].as_ref().unwrap(), results[j].as_ref().unwrap());
+                let s = mesh_separation(
+                    MeshRef {
+                        mesh: &a.mesh,
+                        bvh: &TriangleBvh::build(&a.mesh),
+                    },
+                    &Pose::IDENTITY,
+                    MeshRef {
+                        mesh: &b.mesh,
+                        bvh: &TriangleBvh::build(&b.mesh),
+                    },
+                    &Pose::IDENTITY,
+                );
+                worst = worst.max(-s.signed_gap());
+            }
+        }
+        worst
+    };
+    let before = deepest(&results);
+    assert!(before > 0.3, "the roots were to cross: {before} mm");
+    keep_roots_apart(&fdis, &inputs, &mut results, &mut guides, &limits);
+    let after = deepest(&results);
+    assert!(
+        after <= 0.05,
+        "still {after} mm inside ({before} mm before)"
+    );
+    for (f, r) in fdis.iter().zip(&results) {
+        let root = r.as_ref().unwrap().repairs.root.clone().unwrap();
+        assert_eq!(root.kind, "template", "{f}");
+        if f.kind() == ToothKind::CentralIncisor {
+            assert!(root.tilt_deg < 9.0, "{f}: {root:?}");
         }
     }
 }

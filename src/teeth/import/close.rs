@@ -19,8 +19,8 @@ use super::{
     fill::fill_hole,
     occlusal_direction,
     repair::{self, RepairLimits, Repairs, RootReport},
-    root,
-    template::{self, Template},
+    root, sweep,
+    template::{self, NoTemplate, Template},
 };
 use crate::geometry::{MeshError, TriMesh};
 use crate::teeth::fdi::Fdi;
@@ -51,10 +51,6 @@ pub(super) struct Closed {
     pub apical: Option<Vec3>,
 }
 
-/// Farthest (mm, root mean square) a crown may lie from its fitted template for the template's
-/// root to be used.
-pub const MAX_FIT_RMS_MM: f32 = 1.0;
-
 /// Which root a scanned crown gets.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum RootChoice {
@@ -75,7 +71,7 @@ pub(super) fn close(
     choice: RootChoice,
 ) -> Result<Closed, ImportError> {
     // The template and its fit, once the margin is known (None: the cone, and why).
-    let mut fitted: Option<Result<(std::sync::Arc<Template>, template::Fit), String>> = None;
+    let mut fitted: Option<Result<(std::sync::Arc<Template>, template::Fit), NoTemplate>> = None;
     let budget = (limits.max_cut_fraction * crown.triangles.len() as f32) as usize;
     let (mut trims, mut round) = (0, 0);
     loop {
@@ -109,16 +105,14 @@ pub(super) fn close(
             }
             if fitted.is_none() {
                 fitted = Some(match choice {
-                    RootChoice::Cone => Err("the cone was asked for".into()),
+                    RootChoice::Cone => Err(NoTemplate::NotAsked),
                     RootChoice::Template(guide) => {
                         let t = Template::of(fdi.arch(), fdi.kind());
                         match template::fit(&base, fdi, guide.guess, centre, apical) {
-                            Some(f) if f.rms_mm <= MAX_FIT_RMS_MM => Ok((t, guide.applied_to(f))),
-                            Some(f) => Err(format!(
-                                "the crown lies {:.2} mm (rms) from its template, more than {MAX_FIT_RMS_MM} mm",
-                                f.rms_mm
-                            )),
-                            None => Err("too few vertices to fit a template".into()),
+                            Some(f) => f
+                                .usable(centre, guide.guess)
+                                .map(|()| (t, guide.applied_to(f))),
+                            None => Err(NoTemplate::TooFew),
                         }
                     }
                 });
@@ -159,7 +153,7 @@ pub(super) fn close(
             let mut mesh = base.clone();
             let (cervical, root, apical) = match (margin, guide) {
                 (Some(m), Some((t, f))) => {
-                    let r = root::close_with_template(&mut mesh, &loops[m], gap, t, f)?;
+                    let r = sweep::close_with_template(&mut mesh, &loops[m], gap, t, f)?;
                     let (tilt_deg, shortened_mm) = match choice {
                         RootChoice::Template(g) => (
                             g.tilt.length().to_degrees(),
@@ -187,7 +181,11 @@ pub(super) fn close(
                         fit_rms_mm: None,
                         tilt_deg: 0.0,
                         shortened_mm: 0.0,
-                        fallback: fitted.as_ref().and_then(|f| f.as_ref().err().cloned()),
+                        fallback: fitted
+                            .as_ref()
+                            .and_then(|f| f.as_ref().err())
+                            .filter(|e| **e != NoTemplate::NotAsked)
+                            .map(|e| e.to_string()),
                     };
                     (Some(c), Some(report), Some(a))
                 }

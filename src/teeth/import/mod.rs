@@ -42,6 +42,7 @@ pub mod rebuild;
 pub mod repair;
 pub mod root;
 pub mod segments;
+pub mod sweep;
 pub mod template;
 
 use std::path::Path;

@@ -169,16 +169,20 @@ fn close_leniently(
         };
         let root_length = anatomy(fdi.arch(), fdi.kind()).root_length;
         let template = Template::of(fdi.arch(), fdi.kind());
-        let fit = template::fit(&mesh, fdi, guide.guess, centre, apical)
-            .filter(|f| f.rms_mm <= super::close::MAX_FIT_RMS_MM)
-            .map(|f| guide.applied_to(f));
+        let fit = template::fit(&mesh, fdi, guide.guess, centre, apical);
         let mut templated = mesh.clone();
-        let made = fit.and_then(|f| {
-            root::close_with_template(&mut templated, &loops[m], root::GAPS_MM[0], &template, &f)
-                .ok()
-                .map(|r| (f, r))
-        });
-        if let Some((f, r)) = made {
+        let made = match fit {
+            None => Err(template::NoTemplate::TooFew),
+            Some(f) => f.usable(centre, guide.guess).and_then(|()| {
+                let f = guide.applied_to(f);
+                let gap = root::GAPS_MM[0];
+                super::sweep::close_with_template(&mut templated, &loops[m], gap, &template, &f)
+                    .map(|r| (f, r))
+                    .map_err(|e| template::NoTemplate::NotClosed(Box::new(e)))
+            }),
+        };
+        if let Ok((f, r)) = &made {
+            let (f, r) = (*f, *r);
             mesh = templated;
             repairs.root = Some(RootReport {
                 kind: "template",
@@ -207,7 +211,7 @@ fn close_leniently(
                 fit_rms_mm: fit.map(|f| f.rms_mm),
                 tilt_deg: 0.0,
                 shortened_mm: 0.0,
-                fallback: Some("no template fits the crown".into()),
+                fallback: made.err().map(|e| e.to_string()),
             });
             cervical = Some(centre);
             axis = Some(apical);
@@ -399,11 +403,17 @@ mod tests {
             assert!(r.reason.contains("intersects itself"), "{}", r.reason);
             assert!(r.mean_mm <= 0.05 && r.p95_mm <= 0.1, "{fdi}: {r:?}");
             assert!(rebuilt.repairs.summary().contains("rebuilt"));
-            // The root is generated, about the table's length beyond the crown.
+            // The root is generated, about the table's length beyond the crown along its axis.
             assert!(rebuilt.cervical.is_some());
             let an = anatomy(f.arch(), f.kind());
-            let depth = mesh.aabb().min.y - rebuilt.mesh.aabb().min.y;
-            assert!(depth > 0.6 * an.root_length, "{fdi}: root {depth} mm");
+            let a = rebuilt.apical.expect("a root axis");
+            let reach = |m: &TriMesh| m.vertices.iter().map(|v| v.dot(a)).fold(f32::MIN, f32::max);
+            let depth = reach(&rebuilt.mesh) - reach(&mesh);
+            assert!(
+                depth > 0.6 * an.root_length,
+                "{fdi}: root {depth} mm, {:?}",
+                rebuilt.repairs.root
+            );
             // Scan resolution, not the grid's.
             assert!(
                 rebuilt.mesh.triangles.len() < 8 * MIN_REBUILT_VERTICES,

@@ -169,194 +169,21 @@ pub fn close_with_root_along(
     }
 }
 
-/// Rings of a template root's body: at `t = k / TEMPLATE_RING_STEPS` for `k < TEMPLATE_RINGS`;
-/// a cone closes the body from the last one to the apex.
-pub const TEMPLATE_RINGS: usize = 15;
-/// Steps from the collar to the apex that a template root's rings are placed on.
-pub const TEMPLATE_RING_STEPS: usize = 16;
-/// Share of the root's depth over which a template root's rings turn from the margin's outline
-/// into the template's cross-sections.
-pub const TEMPLATE_BLEND: f64 = 0.35;
-/// Thinnest a template root's cross-section gets (mm from its centre), between the lobes of
-/// several roots and at the apex.
-pub const TEMPLATE_MIN_RADIUS_MM: f32 = 0.3;
-/// Directions a template's cross-section is sampled in (then interpolated by angle).
-pub const SECTION_SAMPLES: usize = 48;
-
-/// What a template root came to: its length and how far its axis is from the margin's normal.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TemplateRoot {
-    /// From the template's cervical centre to the apex along the root's axis (mm).
-    pub length_mm: f32,
-    /// Angle (degrees) between the root's axis and the margin's apical normal.
-    pub axis_deg: f32,
-    /// The cervical centre: where the template's long axis meets its cementoenamel junction.
-    pub cervical: Vec3,
-}
-
-/// Closes the margin `l` of `mesh` with the root of the `template` fitted to the crown (`fit`):
-/// the collar hangs from the margin towards the template's axis as in [`close_with_root_along`]
-/// (its plane `gap` mm beyond the crown's deepest vertex along that axis), and the body's rings
-/// turn from the margin's outline into the template's cross-sections along its axis, down to its
-/// apex.
-///
-/// Construction and guarantee. The rings lie in parallel planes across the axis, at increasing
-/// depths beyond the collar's plane. When the collar's outline is star-shaped about its centre
-/// (strictly increasing angles), ring `k`'s vertex `i` is `c_k + r_ki · d_i`: one direction `d_i`
-/// per margin vertex for every ring, a centre `c_k` per ring, any radius `r_ki > 0`. The
-/// cross-section of the band between two rings at any depth then has its vertices at strictly
-/// increasing angles about the interpolated centre (on the quads' edges and their diagonals, each
-/// between two neighbouring directions), so it is simple, and no two depths meet: the body meets
-/// itself only along shared edges, as the scaled rings of [`close_with_root_along`] do. An outline
-/// that is not star-shaped keeps its shape, each ring a scaled and moved copy of it (same
-/// argument). The cone to the apex has the last ring's centre below it. Radii come from the
-/// template's cross-section in each direction (its outermost surface, at least
-/// [`TEMPLATE_MIN_RADIUS_MM`]; several roots show as lobes joined by a thin web), blended with the
-/// outline over the first [`TEMPLATE_BLEND`] of the depth.
-///
-/// # Errors
-/// [`ImportError::FlatMargin`] when the margin encloses no area.
-pub fn close_with_template(
-    mesh: &mut TriMesh,
-    l: &[u32],
-    gap: f32,
-    template: &super::template::Template,
-    fit: &super::template::Fit,
-) -> Result<TemplateRoot, ImportError> {
-    let (_, margin_apical) = margin_axis(mesh, l)?;
-    let apical = fit.apical();
-    let cervical = fit.origin;
-    let length = fit.root_length(template);
-    let f = Focus::new(mesh, cervical, apical, length);
-    let (c, a, u, w) = (f.c, f.a, f.u, f.w);
-    let h0 = f.deepest + f64::from(gap);
-    let apex_depth = f64::from(length).max(h0 + 0.3 * f64::from(length));
-    let projected = f.project(mesh, l);
-    let outline = untangle(&projected, MIN_SEPARATION_MM)
-        .unwrap_or_else(|| star(&projected, MIN_SEPARATION_MM));
-    let to_h0 = (f.depth - h0) / (f.depth - f.deepest);
-    let ring0: Vec<DVec2> = outline.iter().map(|&q| q * to_h0).collect();
-    let pivot = area_centroid(&ring0);
-    let place = |q: DVec2, depth: f64| (c + a * depth + u * q.x + w * q.y).as_vec3();
-    let in_plane = |p: Vec3| {
-        let d = p.as_dvec3() - c;
-        DVec2::new(d.dot(u), d.dot(w))
-    };
-    let starry = star_shaped(&ring0, pivot);
-    // The template's sections, sampled at evenly spaced angles about the axis.
-    let angles: Vec<f64> = (0..SECTION_SAMPLES)
-        .map(|k| k as f64 / SECTION_SAMPLES as f64 * std::f64::consts::TAU)
-        .collect();
-    let dirs: Vec<Vec3> = angles
-        .iter()
-        .map(|&t| (u * t.cos() + w * t.sin()).as_vec3())
-        .collect();
-    let radius_at = |radii: &[f32], d: DVec2| -> f64 {
-        let t = d.y.atan2(d.x).rem_euclid(std::f64::consts::TAU);
-        let x = t / std::f64::consts::TAU * SECTION_SAMPLES as f64;
-        let i = (x.floor() as usize) % SECTION_SAMPLES;
-        let j = (i + 1) % SECTION_SAMPLES;
-        let s = x - x.floor();
-        f64::from(radii[i]) * (1.0 - s) + f64::from(radii[j]) * s
-    };
-    let mean_ring0 =
-        ring0.iter().map(|q| q.distance(pivot)).sum::<f64>() / ring0.len().max(1) as f64;
-    let mut prev: Vec<u32> = l.to_vec();
-    let mut centre = pivot;
-    for k in 0..TEMPLATE_RINGS {
-        let t = k as f64 / TEMPLATE_RING_STEPS as f64;
-        let depth = h0 + (apex_depth - h0) * t;
-        let blend = smooth(t / TEMPLATE_BLEND);
-        let shrink = (1.0 - t).powf(0.7);
-        let (at, radii) = super::template::section(
-            template,
-            fit,
-            a.as_vec3(),
-            depth as f32,
-            &dirs,
-            TEMPLATE_MIN_RADIUS_MM,
-        );
-        let target = in_plane(at);
-        centre = pivot * (1.0 - blend) + target * blend;
-        let base = mesh.vertices.len() as u32;
-        if starry {
-            for &q in &ring0 {
-                let d = (q - pivot).normalize();
-                let own = q.distance(pivot) * shrink;
-                let r = own * (1.0 - blend) + radius_at(&radii, d) * blend;
-                mesh.vertices.push(place(centre + d * r.max(1e-3), depth));
-            }
-        } else {
-            let mean_template =
-                radii.iter().map(|&r| f64::from(r)).sum::<f64>() / radii.len().max(1) as f64;
-            let scale = shrink * (1.0 - blend) + mean_template / mean_ring0.max(1e-6) * blend;
-            for &q in &ring0 {
-                mesh.vertices
-                    .push(place(centre + (q - pivot) * scale.max(1e-3), depth));
-            }
-        }
-        let ring: Vec<u32> = (0..ring0.len() as u32).map(|i| base + i).collect();
-        join(mesh, &prev, &ring);
-        prev = ring;
-    }
-    let apex = mesh.vertices.len() as u32;
-    mesh.vertices.push(place(centre, apex_depth));
-    for i in 0..prev.len() {
-        let (p, q) = (prev[i], prev[(i + 1) % prev.len()]);
-        mesh.triangles.push([q, p, apex]);
-    }
-    Ok(TemplateRoot {
-        length_mm: apex_depth as f32,
-        axis_deg: apical.angle_between(margin_apical).to_degrees(),
-        cervical,
-    })
-}
-
-/// Smoothstep on [0, 1].
-fn smooth(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    x * x * (3.0 - 2.0 * x)
-}
-
-/// True when every vertex of `p` is at a strictly larger angle about `centre` than the one before,
-/// all the way round once (either way round).
-fn star_shaped(p: &[DVec2], centre: DVec2) -> bool {
-    let n = p.len();
-    if n < 3 {
-        return false;
-    }
-    let mut total = 0.0;
-    let mut sign = 0.0;
-    for i in 0..n {
-        let (a, b) = (p[i] - centre, p[(i + 1) % n] - centre);
-        if a.length() < 1e-9 || b.length() < 1e-9 {
-            return false;
-        }
-        let step = a.perp_dot(b).atan2(a.dot(b));
-        if step == 0.0 || (sign != 0.0 && step.signum() != sign) {
-            return false;
-        }
-        sign = step.signum();
-        total += step;
-    }
-    (total.abs() - std::f64::consts::TAU).abs() < 1e-6
-}
-
 /// Where the collar's strips converge: a point on the root's axis one root length beyond the
 /// crown's deepest vertex, and the frame the margin is projected in.
-struct Focus {
-    c: DVec3,
-    a: DVec3,
-    u: DVec3,
-    w: DVec3,
+pub(super) struct Focus {
+    pub(super) c: DVec3,
+    pub(super) a: DVec3,
+    pub(super) u: DVec3,
+    pub(super) w: DVec3,
     /// Depth (along `a`, from `c`) of the crown's deepest vertex.
-    deepest: f64,
+    pub(super) deepest: f64,
     /// Depth of the focus.
-    depth: f64,
+    pub(super) depth: f64,
 }
 
 impl Focus {
-    fn new(mesh: &TriMesh, centre: Vec3, apical: Vec3, root_length: f32) -> Self {
+    pub(super) fn new(mesh: &TriMesh, centre: Vec3, apical: Vec3, root_length: f32) -> Self {
         let (c, a) = (centre.as_dvec3(), leaning(apical));
         let u = a.any_orthonormal_vector();
         let w = a.cross(u);
@@ -378,7 +205,7 @@ impl Focus {
 
     /// The margin's vertices projected from the focus onto the plane through the crown's deepest
     /// vertex, in the coordinates of `u` and `w`.
-    fn project(&self, mesh: &TriMesh, l: &[u32]) -> Vec<DVec2> {
+    pub(super) fn project(&self, mesh: &TriMesh, l: &[u32]) -> Vec<DVec2> {
         l.iter()
             .map(|&i| {
                 let d = mesh.vertices[i as usize].as_dvec3() - self.c;
@@ -420,7 +247,7 @@ fn leaning(apical: Vec3) -> DVec3 {
 
 /// Quads between two rings of equal size: `upper` runs in its triangles' edge direction, so the
 /// new triangles run each of its edges the other way.
-fn join(mesh: &mut TriMesh, upper: &[u32], lower: &[u32]) {
+pub(super) fn join(mesh: &mut TriMesh, upper: &[u32], lower: &[u32]) {
     let n = upper.len();
     for i in 0..n {
         let j = (i + 1) % n;
@@ -430,7 +257,7 @@ fn join(mesh: &mut TriMesh, upper: &[u32], lower: &[u32]) {
 }
 
 /// Centroid of a polygon's area (its vertices' mean when it has none).
-fn area_centroid(p: &[DVec2]) -> DVec2 {
+pub(super) fn area_centroid(p: &[DVec2]) -> DVec2 {
     let mut sum = DVec2::ZERO;
     let mut area = 0.0;
     for i in 0..p.len() {
@@ -535,7 +362,7 @@ fn offending(p: &[DVec2], eps: f64) -> Vec<usize> {
 /// Makes `p` simple by moving only the vertices where it is not: each towards the midpoint of
 /// its neighbours (a local smoothing), for up to [`UNTANGLE_ROUNDS`] rounds. None when that does
 /// not suffice.
-fn untangle(p: &[DVec2], eps: f64) -> Option<Vec<DVec2>> {
+pub(super) fn untangle(p: &[DVec2], eps: f64) -> Option<Vec<DVec2>> {
     let n = p.len();
     let mut q = p.to_vec();
     for _ in 0..UNTANGLE_ROUNDS {
@@ -566,7 +393,7 @@ fn untangle(p: &[DVec2], eps: f64) -> Option<Vec<DVec2>> {
 /// precision can hold apart once the root's rings are stored. So the steps keep a share of the
 /// mean step, and when that is not enough, the angles are evened out and the radii averaged
 /// over wider windows, the last time over the whole outline (a circle).
-fn star(p: &[DVec2], eps: f64) -> Vec<DVec2> {
+pub(super) fn star(p: &[DVec2], eps: f64) -> Vec<DVec2> {
     let mut outline = Vec::new();
     for &(share, half) in &STAR_SMOOTHING {
         outline = star_with(p, share, half);

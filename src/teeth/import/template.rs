@@ -48,6 +48,57 @@ pub const ITERATIONS: usize = 16;
 /// templates themselves it lengthened roots by 8 %).
 pub const SCALE_LIMITS: [(f32, f32); 3] = [(0.75, 1.3), (1.0, 1.0), (0.75, 1.3)];
 
+/// Farthest (mm, root mean square) a crown may lie from its fitted template for the template's
+/// root to be used.
+pub const MAX_FIT_RMS_MM: f32 = 1.0;
+/// Where the margin's centre may lie relative to the fitted template's cementoenamel junction
+/// (mm along the axis, positive occlusal): the gum line stands up to a few millimetres above it,
+/// or a little below where the gum has receded. A fit outside this slid along the tooth.
+pub const MARGIN_HEIGHT_MM: (f32, f32) = (-2.5, 5.0);
+
+/// Why a crown gets no template root.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum NoTemplate {
+    /// The fit stays far from the crown.
+    #[error("the crown lies {rms_mm:.2} mm (rms) from its template, more than {MAX_FIT_RMS_MM} mm")]
+    TooFar {
+        /// Root-mean-square distance (mm).
+        rms_mm: f32,
+    },
+    /// The fit turned far from the arrangement's axis.
+    #[error(
+        "the fitted template's axis is {deg:.0}° from the arrangement's, more than {MAX_TURN_FROM_GUESS_DEG}°"
+    )]
+    Turned {
+        /// Angle between the axes (degrees).
+        deg: f32,
+    },
+    /// The fit slid along the tooth.
+    #[error(
+        "the fitted template's cementoenamel junction lies {height_mm:.1} mm apical of the margin's centre, outside {} to {} mm",
+        MARGIN_HEIGHT_MM.0,
+        MARGIN_HEIGHT_MM.1
+    )]
+    Slid {
+        /// Where the margin's centre lies above the fitted junction (mm, negative below).
+        height_mm: f32,
+    },
+    /// The crown has too few vertices to fit.
+    #[error("too few vertices to fit a template")]
+    TooFew,
+    /// The template root was not asked for.
+    #[error("the cone was asked for")]
+    NotAsked,
+    /// The template root could not be closed without meeting the crown.
+    #[error("the template root could not be closed: {0}")]
+    NotClosed(Box<super::error::ImportError>),
+}
+
+/// Largest angle (degrees) between the fitted template's axis and the axis of the tooth's pose in
+/// the arrangement, when that is known: patients' teeth stand tipped and crowded, but a fit
+/// turned farther than this went astray on a crown far from its type's shape.
+pub const MAX_TURN_FROM_GUESS_DEG: f32 = 35.0;
+
 /// A tooth type's template: its solid and a mesh of its surface with a hierarchy.
 pub struct Template {
     /// The implicit solid (local frame: cervical centre at the origin, y occlusal, z buccal).
@@ -117,6 +168,40 @@ impl Fit {
     /// The template's apical direction (unit, world): its long axis from crown to root.
     pub fn apical(&self) -> Vec3 {
         self.rotation * Vec3::NEG_Y
+    }
+
+    /// How far (mm) the margin's centre lies occlusal of the template's cervical centre, along the
+    /// template's axis (the gum line stands on or above the cementoenamel junction).
+    pub fn margin_height(&self, margin_centre: Vec3) -> f32 {
+        (self.origin - margin_centre).dot(self.apical())
+    }
+
+    /// Whether the fit can carry a root: near enough the crown, its cementoenamel junction where
+    /// the margin says.
+    ///
+    /// # Errors
+    /// Why it cannot ([`NoTemplate`]).
+    pub fn usable(&self, margin_centre: Vec3, guess: Option<Pose>) -> Result<(), NoTemplate> {
+        if self.rms_mm > MAX_FIT_RMS_MM {
+            return Err(NoTemplate::TooFar {
+                rms_mm: self.rms_mm,
+            });
+        }
+        if let Some(g) = guess {
+            let deg = self
+                .apical()
+                .angle_between(g.rotation * Vec3::NEG_Y)
+                .to_degrees();
+            if deg > MAX_TURN_FROM_GUESS_DEG {
+                return Err(NoTemplate::Turned { deg });
+            }
+        }
+        let height_mm = self.margin_height(margin_centre);
+        let (lo, hi) = MARGIN_HEIGHT_MM;
+        if !(lo..=hi).contains(&height_mm) {
+            return Err(NoTemplate::Slid { height_mm });
+        }
+        Ok(())
     }
 
     /// The template's root length (mm, scaled), from its cervical centre to its deepest apex.
