@@ -278,6 +278,15 @@ impl ToothSolid {
         cone.min(tip)
     }
 
+    /// The roots' separation depth below the cervical line and each root's axis (from the star
+    /// centre to its apex), local frame; no axes for a single-rooted tooth.
+    pub fn root_axes(&self) -> (f32, Vec<(Vec3, Vec3)>) {
+        (
+            self.trunk,
+            self.roots.iter().map(|r| (self.centre, r.apex)).collect(),
+        )
+    }
+
     /// Approximate signed distance of the whole tooth (negative inside).
     pub fn distance(&self, p: Vec3) -> f32 {
         let mut d = self.body(p);

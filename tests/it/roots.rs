@@ -117,7 +117,8 @@ fn roots_that_start_crossing_are_turned_apart() {
         .iter()
         .map(|&f| {
             let tooth = d.tooth(f).unwrap();
-            // Apex towards the midline (x = 0): about the tooth's buccal axis.
+            // Lateral incisors' apices towards the midline (x = 0), central incisors' away from
+            // it: about each tooth's buccal axis.
             let buccal = tooth.pose.rotation * Vec3::Z;
             let toward = if tooth.pose.translation.x > 0.0 {
                 -1.0
@@ -125,14 +126,14 @@ fn roots_that_start_crossing_are_turned_apart() {
                 1.0
             };
             let turn = if f.kind() == ToothKind::CentralIncisor {
-                9f32
+                -14f32
             } else {
-                0.0
+                14.0
             };
             RootGuide {
                 guess: Some(tooth.pose),
                 tilt: buccal * toward * turn.to_radians(),
-                shorten: 0.0,
+                ..RootGuide::default()
             }
         })
         .collect();
@@ -175,8 +176,38 @@ fn roots_that_start_crossing_are_turned_apart() {
     for (f, r) in fdis.iter().zip(&results) {
         let root = r.as_ref().unwrap().repairs.root.clone().unwrap();
         assert_eq!(root.kind, "template", "{f}");
-        if f.kind() == ToothKind::CentralIncisor {
-            assert!(root.tilt_deg < 9.0, "{f}: {root:?}");
-        }
+        assert!(root.tilt_deg < 14.0, "{f}: {root:?}");
+    }
+}
+
+#[test]
+fn molars_and_the_upper_first_premolar_get_their_roots() {
+    // Cut across the root axis two thirds of the way to the apex: a lower molar shows two roots,
+    // an upper molar three, the upper first premolar two, a lower premolar one.
+    let d = normal();
+    let limits = RepairLimits::default();
+    for (n, roots) in [(36, 2), (47, 2), (16, 3), (27, 3), (14, 2), (44, 1)] {
+        let fdi = Fdi::new(n).unwrap();
+        let tooth = d.tooth(fdi).unwrap();
+        let scan = scan_like_crown(
+            fdi.arch(),
+            fdi.kind(),
+            &tooth.pose,
+            1500,
+            &ScanDefects::CLEAN,
+            n as u64,
+        );
+        let guide = RootGuide {
+            guess: Some(tooth.pose),
+            ..RootGuide::default()
+        };
+        let p = prepare_guided(&scan.mesh, fdi, &limits, guide).unwrap();
+        p.mesh.validate_solid().unwrap();
+        let root = p.repairs.root.clone().unwrap();
+        assert_eq!(root.kind, "template", "{n}: {root:?}");
+        let (c, a) = (p.cervical.unwrap(), p.apical.unwrap());
+        let at = c + a * (root.length_mm * 0.67);
+        let loops = orthosim::geometry::section_loops(&p.mesh, at, a);
+        assert_eq!(loops, roots, "{n}: {loops} roots at two thirds");
     }
 }

@@ -118,12 +118,12 @@ pub fn keep_roots_apart(
                 let away = (away - a * away.dot(a)).normalize_or_zero();
                 let axis = a.cross(away).normalize_or_zero();
                 let g = &mut guides[k];
-                if g.tilt.length() + 1e-4 < MAX_TILT_DEG.to_radians() && axis != Vec3::ZERO {
-                    g.tilt += axis * TILT_STEP_DEG.to_radians();
-                    let len = g.tilt.length();
-                    if len > MAX_TILT_DEG.to_radians() {
-                        g.tilt *= MAX_TILT_DEG.to_radians() / len;
-                    }
+                if g.turned_apart + 1e-4 < MAX_TILT_DEG.to_radians() && axis != Vec3::ZERO {
+                    let step = TILT_STEP_DEG
+                        .to_radians()
+                        .min(MAX_TILT_DEG.to_radians() - g.turned_apart);
+                    g.tilt += axis * step;
+                    g.turned_apart += step;
                     turned[k] = true;
                 } else if g.shorten + 1e-4 < MAX_SHORTEN {
                     g.shorten = (g.shorten + SHORTEN_STEP).min(MAX_SHORTEN);

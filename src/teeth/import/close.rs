@@ -149,11 +149,21 @@ pub(super) fn close(
             &[0.0]
         };
         let mut fewest: Option<(TriMesh, Vec<(usize, usize)>)> = None;
-        for &gap in gaps {
+        // With a template, each gap is tried with the body's star-shaped band first (the
+        // template's sections and roots), then without it.
+        let bodies: &[bool] = if guide.is_some() {
+            &[true, false]
+        } else {
+            &[false]
+        };
+        let attempts = gaps
+            .iter()
+            .flat_map(|&g| bodies.iter().map(move |&b| (g, b)));
+        for (gap, star_body) in attempts {
             let mut mesh = base.clone();
             let (cervical, root, apical) = match (margin, guide) {
                 (Some(m), Some((t, f))) => {
-                    let r = sweep::close_with_template(&mut mesh, &loops[m], gap, t, f)?;
+                    let r = sweep::close_with_template(&mut mesh, &loops[m], gap, t, f, star_body)?;
                     let (tilt_deg, shortened_mm) = match choice {
                         RootChoice::Template(g) => (
                             g.tilt.length().to_degrees(),
@@ -163,6 +173,7 @@ pub(super) fn close(
                     };
                     let report = RootReport {
                         kind: "template",
+                        roots: r.roots,
                         length_mm: r.length_mm,
                         axis_deg: r.axis_deg,
                         fit_rms_mm: Some(f.rms_mm),
@@ -176,6 +187,7 @@ pub(super) fn close(
                     let (c, a) = root::close_with_root(&mut mesh, &loops[m], root_length, gap)?;
                     let report = RootReport {
                         kind: "cone",
+                        roots: 1,
                         length_mm: root_length,
                         axis_deg: root::LEAN_RAD.to_degrees() as f32,
                         fit_rms_mm: None,

@@ -329,6 +329,8 @@ pub struct RootGuide {
     pub tilt: Vec3,
     /// Share of the template's root length taken off (0–1).
     pub shorten: f32,
+    /// How far (radians) [`apart::keep_roots_apart`] has turned the root so far (part of `tilt`).
+    pub turned_apart: f32,
 }
 
 impl RootGuide {

@@ -176,9 +176,16 @@ fn close_leniently(
             Some(f) => f.usable(centre, guide.guess).and_then(|()| {
                 let f = guide.applied_to(f);
                 let gap = root::GAPS_MM[0];
-                super::sweep::close_with_template(&mut templated, &loops[m], gap, &template, &f)
-                    .map(|r| (f, r))
-                    .map_err(|e| template::NoTemplate::NotClosed(Box::new(e)))
+                super::sweep::close_with_template(
+                    &mut templated,
+                    &loops[m],
+                    gap,
+                    &template,
+                    &f,
+                    true,
+                )
+                .map(|r| (f, r))
+                .map_err(|e| template::NoTemplate::NotClosed(Box::new(e)))
             }),
         };
         if let Ok((f, r)) = &made {
@@ -186,6 +193,7 @@ fn close_leniently(
             mesh = templated;
             repairs.root = Some(RootReport {
                 kind: "template",
+                roots: r.roots,
                 length_mm: r.length_mm,
                 axis_deg: r.axis_deg,
                 fit_rms_mm: Some(f.rms_mm),
@@ -206,6 +214,7 @@ fn close_leniently(
             );
             repairs.root = Some(RootReport {
                 kind: "cone",
+                roots: 1,
                 length_mm: root_length,
                 axis_deg: apical.angle_between(own).to_degrees(),
                 fit_rms_mm: fit.map(|f| f.rms_mm),

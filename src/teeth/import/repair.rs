@@ -104,6 +104,8 @@ pub struct RootReport {
     pub kind: &'static str,
     /// From the cervical centre to the apex (mm).
     pub length_mm: f32,
+    /// Separate roots below the furcation (1 for a single root or a cone).
+    pub roots: usize,
     /// Angle (degrees) between the root's axis and the margin's apical normal.
     pub axis_deg: f32,
     /// How far (mm, root mean square) the crown lies from the fitted template's surface.
@@ -175,6 +177,10 @@ impl Repairs {
         }
         if let Some(l) = self.root_generated_margin_mm {
             let root = match &self.root {
+                Some(r) if r.kind == "template" && r.roots > 1 => format!(
+                    "template roots ({}, {:.1} mm, {:.0}° from the margin's normal)",
+                    r.roots, r.length_mm, r.axis_deg
+                ),
                 Some(r) if r.kind == "template" => format!(
                     "template root ({:.1} mm, {:.0}° from the margin's normal)",
                     r.length_mm, r.axis_deg

@@ -309,7 +309,7 @@ fn is_simple(p: &[DVec2], eps: f64) -> bool {
 
 /// The vertices of `p` at which it is not simple with room to spare (see [`is_simple`]): both
 /// ends of a short edge, the middle vertex of a fold, the ends of edges that come too close.
-fn offending(p: &[DVec2], eps: f64) -> Vec<usize> {
+pub(super) fn offending(p: &[DVec2], eps: f64) -> Vec<usize> {
     let n = p.len();
     let mut bad = vec![false; n];
     let edge = |i: usize| (p[i], p[(i + 1) % n]);
@@ -418,7 +418,7 @@ pub const STAR_SMOOTHING: [(f64, usize); 4] = [
 /// strictly increasing (the backward steps of a jagged outline flattened out, each step at least
 /// `share` of the mean one), radii averaged over `half` neighbours each side. Simple by
 /// construction.
-fn star_with(p: &[DVec2], share: f64, half: usize) -> Vec<DVec2> {
+pub(super) fn star_with(p: &[DVec2], share: f64, half: usize) -> Vec<DVec2> {
     let n = p.len();
     let half = half.min(n.saturating_sub(1) / 2);
     let centre = area_centroid(p);

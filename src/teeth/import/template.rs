@@ -3,9 +3,9 @@
 //!
 //! A scan sees the crown above the gum only. The root a crown gets follows the template's long
 //! axis and reaches the template's apex, with the template's cross-sections below the collar
-//! (two or three lobes for premolars and molars with several roots), so roots follow the tooth's
+//! (and its two or three roots where it has them), so roots follow the tooth's
 //! anatomy instead of the margin's normal (which a scalloped or bleeding gum line tilts by tens of
-//! degrees). [`super::root::close_with_template`] builds the root from a [`Fit`].
+//! degrees). [`super::sweep::close_with_template`] builds the root from a [`Fit`].
 //!
 //! Fit: the template's surface (a mesh of [`TEMPLATE_VERTICES`] vertices) is brought onto the
 //! scanned crown by iterative closest points: each of up to [`SAMPLES`] crown vertices is paired
@@ -345,19 +345,40 @@ pub fn section(
     let apical = fit.apical();
     let along = apical.dot(axis).max(0.2);
     let centre = fit.origin + apical * (depth / along);
-    let reach = 0.8
-        * (template
-            .anatomy
-            .mesiodistal
-            .max(template.anatomy.buccolingual))
+    let reaches = vec![reach_of(template, fit); dirs.len()];
+    (
+        centre,
+        section_from(template, fit, centre, dirs, &reaches, min_mm),
+    )
+}
+
+/// Distance (mm) beyond which no part of the fitted template lies from its axis.
+pub fn reach_of(template: &Template, fit: &Fit) -> f32 {
+    0.8 * (template
+        .anatomy
+        .mesiodistal
+        .max(template.anatomy.buccolingual))
         * fit.scale.max_element()
-        + 2.0;
+        + 2.0
+}
+
+/// The distance from `centre` (world) to the fitted template's outermost surface point in each
+/// world direction `dirs` (unit), looking no farther than `reaches` (mm, per direction), at least
+/// `min_mm`.
+pub fn section_from(
+    template: &Template,
+    fit: &Fit,
+    centre: Vec3,
+    dirs: &[Vec3],
+    reaches: &[f32],
+    min_mm: f32,
+) -> Vec<f32> {
     let inside = |p: Vec3| template.solid.distance(fit.to_local(p)) < 0.0;
-    let radii = dirs
-        .iter()
-        .map(|&dir| {
-            // March inwards from beyond the tooth: the first point inside is on the outermost
-            // surface; bisection then finds it to 0.01 mm.
+    dirs.iter()
+        .zip(reaches)
+        .map(|(&dir, &reach)| {
+            // March inwards from the reach: the first point inside is on the outermost surface;
+            // bisection then finds it to 0.01 mm.
             const STEP: f32 = 0.25;
             let mut outer = reach;
             let mut r = reach - STEP;
@@ -379,8 +400,7 @@ pub fn section(
             }
             lo.max(min_mm)
         })
-        .collect();
-    (centre, radii)
+        .collect()
 }
 
 #[cfg(test)]
