@@ -6,19 +6,16 @@ use orthosim::{
     geometry::{MeshRef, Pose, TriangleBvh, mesh_separation},
     prelude::*,
     teeth::{
-        Dentition,
         anatomy::anatomy,
         arch::ArchCurve,
         import::{
             ImportError, Prepared, RepairLimits, RootGuide, apart::keep_roots_apart, prepare_guided,
         },
-        scan_like::{ScanDefects, scan_like_crown},
+        scan_like::ScanDefects,
     },
 };
 
-fn normal() -> Dentition {
-    Dentition::build(Case::resolve("normal").unwrap()).unwrap()
-}
+use crate::scans::{normal, scan_of};
 
 #[test]
 fn scan_like_crowns_get_roots_along_the_true_axis_of_the_true_length() {
@@ -38,14 +35,7 @@ fn scan_like_crowns_get_roots_along_the_true_axis_of_the_true_length() {
     ] {
         let fdi = Fdi::new(n).unwrap();
         let tooth = d.tooth(fdi).unwrap();
-        let scan = scan_like_crown(
-            fdi.arch(),
-            fdi.kind(),
-            &tooth.pose,
-            1500,
-            &ScanDefects::typical(seed),
-            seed,
-        );
+        let scan = scan_of(&d, fdi, 1500, &ScanDefects::typical(seed), seed);
         // The fit starts from a pose 8° and 1 mm off the truth, as the arrangement is off a
         // patient's teeth, and without it (from the crown's margin alone).
         let off = Pose::new(
@@ -100,18 +90,7 @@ fn roots_that_start_crossing_are_turned_apart() {
     let inputs: Vec<_> = fdis
         .iter()
         .enumerate()
-        .map(|(i, &f)| {
-            let tooth = d.tooth(f).unwrap();
-            scan_like_crown(
-                f.arch(),
-                f.kind(),
-                &tooth.pose,
-                1200,
-                &ScanDefects::CLEAN,
-                20 + i as u64,
-            )
-            .mesh
-        })
+        .map(|(i, &f)| scan_of(&d, f, 1200, &ScanDefects::CLEAN, 20 + i as u64).mesh)
         .collect();
     let mut guides: Vec<RootGuide> = fdis
         .iter()
@@ -189,14 +168,7 @@ fn molars_and_the_upper_first_premolar_get_their_roots() {
     for (n, roots) in [(36, 2), (47, 2), (16, 3), (27, 3), (14, 2), (44, 1)] {
         let fdi = Fdi::new(n).unwrap();
         let tooth = d.tooth(fdi).unwrap();
-        let scan = scan_like_crown(
-            fdi.arch(),
-            fdi.kind(),
-            &tooth.pose,
-            1500,
-            &ScanDefects::CLEAN,
-            n as u64,
-        );
+        let scan = scan_of(&d, fdi, 1500, &ScanDefects::CLEAN, n as u64);
         let guide = RootGuide {
             guess: Some(tooth.pose),
             ..RootGuide::default()

@@ -15,7 +15,7 @@ use orthosim::{
     },
 };
 
-fn normal() -> Dentition {
+pub(crate) fn normal() -> Dentition {
     Dentition::build(Case::resolve("normal").unwrap()).unwrap()
 }
 
@@ -29,7 +29,7 @@ fn typical_scan(d: &Dentition, fdi: Fdi, triangles: usize, seed: u64) -> ScanLik
 }
 
 /// A scan-like crown of tooth `fdi` where `d` places it, with `defects`.
-fn scan_of(
+pub(crate) fn scan_of(
     d: &Dentition,
     fdi: Fdi,
     triangles: usize,

@@ -135,16 +135,13 @@ pub fn close_with_root_along(
     centre: Vec3,
     apical: Vec3,
 ) {
-    let f = Focus::new(mesh, centre, apical, root_length);
+    let Collar {
+        focus: f,
+        h0,
+        apex_depth,
+        ring: ring0,
+    } = Collar::new(mesh, l, centre, apical, root_length, gap);
     let (c, a, u, w) = (f.c, f.a, f.u, f.w);
-    let h0 = f.deepest + f64::from(gap);
-    let apex_depth = f64::from(root_length).max(h0 + 0.3 * f64::from(root_length));
-    let projected = f.project(mesh, l);
-    let outline = untangle(&projected, MIN_SEPARATION_MM)
-        .unwrap_or_else(|| star(&projected, MIN_SEPARATION_MM));
-    // The collar's strips run from each margin vertex towards the focus, to the plane at h0.
-    let to_h0 = (f.depth - h0) / (f.depth - f.deepest);
-    let ring0: Vec<DVec2> = outline.iter().map(|&q| q * to_h0).collect();
     let pivot = area_centroid(&ring0);
     let place = |q: DVec2, depth: f64| (c + a * depth + u * q.x + w * q.y).as_vec3();
     let mut prev: Vec<u32> = l.to_vec();
@@ -166,6 +163,45 @@ pub fn close_with_root_along(
     for i in 0..prev.len() {
         let (p, q) = (prev[i], prev[(i + 1) % prev.len()]);
         mesh.triangles.push([q, p, apex]);
+    }
+}
+
+/// The collar of a root along `apical` from `centre`: its strips run from each margin vertex
+/// towards the focus, to the plane `gap` mm beyond the crown's deepest vertex, where they end on
+/// the margin's outline seen from the focus (made simple).
+pub(super) struct Collar {
+    pub(super) focus: Focus,
+    /// Depth of the collar's plane.
+    pub(super) h0: f64,
+    /// Depth of the apex: the root length, and at least 30 % of it beyond the collar.
+    pub(super) apex_depth: f64,
+    /// The outline in the collar's plane (in-plane coordinates), one vertex per margin vertex.
+    pub(super) ring: Vec<DVec2>,
+}
+
+impl Collar {
+    pub(super) fn new(
+        mesh: &TriMesh,
+        l: &[u32],
+        centre: Vec3,
+        apical: Vec3,
+        root_length: f32,
+        gap: f32,
+    ) -> Self {
+        let focus = Focus::new(mesh, centre, apical, root_length);
+        let h0 = focus.deepest + f64::from(gap);
+        let apex_depth = f64::from(root_length).max(h0 + 0.3 * f64::from(root_length));
+        let projected = focus.project(mesh, l);
+        let outline = untangle(&projected, MIN_SEPARATION_MM)
+            .unwrap_or_else(|| star(&projected, MIN_SEPARATION_MM));
+        let to_h0 = (focus.depth - h0) / (focus.depth - focus.deepest);
+        let ring = outline.iter().map(|&q| q * to_h0).collect();
+        Self {
+            focus,
+            h0,
+            apex_depth,
+            ring,
+        }
     }
 }
 

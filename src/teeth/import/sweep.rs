@@ -43,8 +43,7 @@ use glam::{DVec2, DVec3, Vec3};
 use super::{
     error::ImportError,
     root::{
-        Focus, MIN_SEPARATION_MM, area_centroid, join, margin_axis, offending, star, star_with,
-        untangle,
+        Collar, MIN_SEPARATION_MM, area_centroid, join, margin_axis, offending, star, star_with,
     },
     template::{Fit, Template, section},
 };
@@ -102,19 +101,17 @@ pub fn close_with_template(
     let apical = fit.apical();
     let cervical = fit.origin;
     let length = fit.root_length(template);
-    let f = Focus::new(mesh, cervical, apical, length);
-    let (c, a, u, w) = (f.c, f.a, f.u, f.w);
-    let h0 = f.deepest + f64::from(gap);
-    let apex_depth = f64::from(length).max(h0 + 0.3 * f64::from(length));
-    let projected = f.project(mesh, l);
     // The collar's outline: the margin seen from the focus, made simple (its strips then hang
     // straight from the margin). The body's rings start from it, or, when `star_body` asks and
     // the outline is not star-shaped about its centre, from a star-shaped copy of it (angles
     // alone made to increase, radii kept) a thin band below it.
-    let outline = untangle(&projected, MIN_SEPARATION_MM)
-        .unwrap_or_else(|| star(&projected, MIN_SEPARATION_MM));
-    let to_h0 = (f.depth - h0) / (f.depth - f.deepest);
-    let collar: Vec<DVec2> = outline.iter().map(|&q| q * to_h0).collect();
+    let Collar {
+        focus: f,
+        h0,
+        apex_depth,
+        ring: collar,
+    } = Collar::new(mesh, l, cervical, apical, length, gap);
+    let (c, a, u, w) = (f.c, f.a, f.u, f.w);
     let centre0 = area_centroid(&collar);
     let ring0: Vec<DVec2> = if !star_body || turning(&collar, centre0).is_some() {
         collar.clone()
