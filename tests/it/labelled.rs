@@ -23,7 +23,7 @@ fn normal() -> Dentition {
     Dentition::build(Case::resolve("normal").unwrap()).unwrap()
 }
 
-fn temp_dir(name: &str) -> std::path::PathBuf {
+pub(crate) fn temp_dir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("orthosim-labelled-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();

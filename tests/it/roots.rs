@@ -6,11 +6,14 @@ use orthosim::{
     geometry::{MeshRef, Pose, TriangleBvh, mesh_separation},
     prelude::*,
     teeth::{
+        Dentition,
         anatomy::anatomy,
         arch::ArchCurve,
         import::{
-            ImportError, Prepared, RepairLimits, RootGuide, apart::keep_roots_apart, prepare_guided,
+            ImportError, Prepared, RepairLimits, RootGuide, apart::keep_roots_apart,
+            export_labelled_scans, prepare_guided,
         },
+        labelled_scan::ScanFormat,
         scan_like::ScanDefects,
     },
 };
@@ -182,4 +185,58 @@ fn molars_and_the_upper_first_premolar_get_their_roots() {
         let loops = orthosim::geometry::section_loops(&p.mesh, at, a);
         assert_eq!(loops, roots, "{n}: {loops} roots at two thirds");
     }
+}
+
+#[test]
+fn a_crowded_lower_front_imports_with_no_teeth_inside_each_other() {
+    // The lower incisors turned 18° and the canines 12° about their long axes, as crowded teeth
+    // stand (their crowns still apart), scanned as one labelled arch: every tooth gets a template
+    // root, and no two teeth start more than 0.05 mm inside each other.
+    let mut d = normal();
+    for (n, deg) in [
+        (31, -18f32),
+        (41, -18.0),
+        (32, -18.0),
+        (42, -18.0),
+        (33, -12.0),
+        (43, -12.0),
+    ] {
+        let t = d.teeth.iter_mut().find(|t| t.fdi.number() == n).unwrap();
+        let axis = t.pose.rotation * Vec3::Y;
+        let cervix = t.pose.translation;
+        t.pose =
+            Pose::turn_about(cervix, Quat::from_axis_angle(axis, deg.to_radians())).mul(&t.pose);
+    }
+    let lower: Vec<_> = d
+        .visible()
+        .filter(|t| t.fdi.arch() == Arch::Lower)
+        .collect();
+    for (i, a) in lower.iter().enumerate() {
+        for b in &lower[i + 1..] {
+            let s = mesh_separation(
+                a.geometry.mesh_ref(),
+                &a.pose,
+                b.geometry.mesh_ref(),
+                &b.pose,
+            );
+            assert!(
+                s.signed_gap() > -0.01,
+                "{}-{} overlap as turned",
+                a.fdi,
+                b.fdi
+            );
+        }
+    }
+    let dir = crate::labelled::temp_dir("crowded");
+    let (report, _) = export_labelled_scans(&d, &dir, 1200, 31, ScanFormat::PlyProperty).unwrap();
+    let imported = Dentition::build(Case::load(&report.case_file).unwrap()).unwrap();
+    for (fdi, r) in &imported.imported {
+        let root = r.root.as_ref().unwrap_or_else(|| panic!("{fdi}: no root"));
+        assert_eq!(root.kind, "template", "{fdi}: {root:?}");
+    }
+    let inspected = orthosim::analysis::inspect::inspect(&imported);
+    for g in &inspected.neighbour_gaps_mm {
+        assert!(g.gap_mm > -0.05, "{}-{}: {} mm", g.a, g.b, g.gap_mm);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
