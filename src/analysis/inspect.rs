@@ -4,6 +4,7 @@
 //! gaps and penetrations come from the exact mesh–mesh query
 //! ([`crate::geometry::mesh_separation`]).
 
+use bevy::math::Vec3;
 use serde::Serialize;
 
 use crate::{
@@ -51,6 +52,33 @@ pub struct NeighbourGap {
     pub b: u8,
     /// Minimal surface distance (mm), negative when they overlap (minus the penetration depth).
     pub gap_mm: f32,
+    /// Where two overlapping teeth meet deepest, when they overlap.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<Overlap>,
+}
+
+/// Where two neighbours overlap: the deepest point and, on each tooth, whether it lies in the
+/// crown or the root (above or below the tooth's cervical line, along its long axis).
+#[derive(Clone, Debug, Serialize)]
+pub struct Overlap {
+    /// Midpoint of the deepest points of the two surfaces, world frame (mm).
+    pub at: [f32; 3],
+    /// "crown" or "root" on the first tooth.
+    pub level_a: &'static str,
+    /// "crown" or "root" on the second tooth.
+    pub level_b: &'static str,
+}
+
+/// "crown" when world point `p` lies above tooth `t`'s cervical line along its long axis, else
+/// "root".
+fn level(t: &PlacedTooth, p: Vec3) -> &'static str {
+    let f = &t.geometry.frame;
+    let local = t.pose.inverse().transform_point(p);
+    if (local - f.cervical_centre).dot(f.long_axis) >= 0.0 {
+        "crown"
+    } else {
+        "root"
+    }
 }
 
 /// The whole report of `orthosim inspect`.
@@ -95,13 +123,16 @@ pub struct ImportedMesh {
 }
 
 fn signed_gap(a: &PlacedTooth, b: &PlacedTooth) -> f32 {
+    separation(a, b).signed_gap()
+}
+
+fn separation(a: &PlacedTooth, b: &PlacedTooth) -> crate::geometry::MeshSeparation {
     mesh_separation(
         a.geometry.mesh_ref(),
         &a.pose,
         b.geometry.mesh_ref(),
         &b.pose,
     )
-    .signed_gap()
 }
 
 /// Reports on mesh `m`'s validity.
@@ -144,10 +175,23 @@ pub fn inspect(d: &Dentition) -> InspectReport {
         .neighbour_pairs()
         .into_iter()
         .filter_map(|(a, b)| Some((d.tooth(a)?, d.tooth(b)?)))
-        .map(|(a, b)| NeighbourGap {
-            a: a.fdi.number(),
-            b: b.fdi.number(),
-            gap_mm: signed_gap(a, b),
+        .map(|(a, b)| {
+            let s = separation(a, b);
+            let gap_mm = s.signed_gap();
+            let overlap = (gap_mm < 0.0).then(|| {
+                let at = 0.5 * (s.point_a + s.point_b);
+                Overlap {
+                    at: at.to_array(),
+                    level_a: level(a, at),
+                    level_b: level(b, at),
+                }
+            });
+            NeighbourGap {
+                a: a.fdi.number(),
+                b: b.fdi.number(),
+                gap_mm,
+                overlap,
+            }
         })
         .collect();
     let visible: Vec<&PlacedTooth> = d.visible().collect();

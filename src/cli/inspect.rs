@@ -135,7 +135,13 @@ fn print_table(report: &InspectReport) {
     }
     println!("neighbour gaps (mm):");
     for g in &report.neighbour_gaps_mm {
-        println!("  {}-{}: {:.3}", g.a, g.b, g.gap_mm);
+        match &g.overlap {
+            Some(o) => println!(
+                "  {}-{}: {:.3} ({} of {} into {} of {} near ({:.2}, {:.2}, {:.2}) mm)",
+                g.a, g.b, g.gap_mm, o.level_a, g.a, o.level_b, g.b, o.at[0], o.at[1], o.at[2]
+            ),
+            None => println!("  {}-{}: {:.3}", g.a, g.b, g.gap_mm),
+        }
     }
     println!(
         "max penetration in an arch: {:.4} mm",

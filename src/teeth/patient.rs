@@ -11,7 +11,7 @@ use super::{
     case::{Case, CaseError, LoadedCase},
     fdi::Fdi,
     import::{
-        ImportError, LabelFix, Placement, Prepared, RepairLimits, RootGuide,
+        CrownAxis, ImportError, LabelFix, Placement, Prepared, RepairLimits, RootGuide,
         apart::keep_roots_apart,
         check_raw, check_scan,
         orient::{Arranged, REFERENCE_RESOLUTION, as_euler_deg, orient},
@@ -197,13 +197,43 @@ pub(super) fn patient_teeth(
             ..RootGuide::default()
         })
         .collect();
+    let worlds: Vec<TriMesh> = sources
+        .iter()
+        .zip(&poses)
+        .map(|(s, pose)| s.mesh.map_vertices(|v| pose.transform_point(v)))
+        .collect();
+    let occlusal = |fdi: Fdi| arrangement.pose(fdi).rotation * glam::Vec3::Y;
+    // Each scanned crown's axis, for its neighbours' trims (`None` for CBCT teeth, which are whole).
+    let axes: Vec<Option<CrownAxis>> = sources
+        .iter()
+        .zip(&worlds)
+        .map(|(s, world)| {
+            let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
+            s.scanned
+                .then(|| CrownAxis::of(world, &an, occlusal(s.fdi)))
+                .flatten()
+        })
+        .collect();
     let first = crate::parallel::parallel_map(&jobs, |&i| {
         let s = &sources[i];
-        let world = s.mesh.map_vertices(|v| poses[i].transform_point(v));
+        let world = worlds[i].clone();
         let (input, fix) = if s.scanned {
-            let occlusal = arrangement.pose(s.fdi).rotation * glam::Vec3::Y;
             let an = super::anatomy::anatomy(s.fdi.arch(), s.fdi.kind());
-            trim_bleed(&world, s.fdi, &an, occlusal)
+            // The nearest tooth present on each side along the arch.
+            let place = |j: usize| sources[j].fdi.arch_index();
+            let same = |j: usize| j != i && sources[j].fdi.arch() == s.fdi.arch();
+            let before = (0..sources.len())
+                .filter(|&j| same(j) && place(j) < place(i))
+                .max_by_key(|&j| place(j));
+            let after = (0..sources.len())
+                .filter(|&j| same(j) && place(j) > place(i))
+                .min_by_key(|&j| place(j));
+            let neighbours: Vec<CrownAxis> = [before, after]
+                .into_iter()
+                .flatten()
+                .filter_map(|j| axes[j])
+                .collect();
+            trim_bleed(&world, s.fdi, &an, occlusal(s.fdi), &neighbours)
         } else {
             (world, None)
         };

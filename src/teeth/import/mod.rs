@@ -68,7 +68,7 @@ pub use labels::{LabelledMesh, Labels, check_raw, check_scan, read_labelled, spl
 pub use read::{MeshFormat, read_mesh, write_stl};
 pub use rebuild::{Rebuilt, rebuild};
 pub use repair::{RepairLimits, Repairs, RootReport};
-pub use segments::{LabelFix, tidy_labels, trim_bleed};
+pub use segments::{CrownAxis, LabelFix, tidy_labels, trim_bleed};
 
 /// Units of a mesh file.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

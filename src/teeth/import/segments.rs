@@ -12,7 +12,10 @@
 //! anatomy's crown length allows ([`BLEED_HEIGHT`]), or further from the crown's axis than its
 //! widest dimension allows ([`BLEED_WIDTH`]; at the neck, below [`BLEED_NECK`] crown lengths,
 //! the cervix's), are gum or a neighbour's margin, and are trimmed when they hang from the
-//! margin.
+//! margin. So are triangles at the neck past the crown's own reach (half its widest anatomical
+//! dimension plus [`NEIGHBOUR_SLACK_MM`]) that lie nearer a neighbouring crown's axis than its own, each
+//! distance taken in units of that crown's reach: a label that runs along a neighbour's margin
+//! would otherwise become a collar inside the neighbour's root.
 
 use std::collections::HashMap;
 
@@ -37,6 +40,50 @@ pub const BLEED_SLACK_MM: f32 = 0.75;
 /// Below this many crown lengths under the tip, the crown's limit is its cervix's widest
 /// dimension rather than its crown's.
 pub const BLEED_NECK: f32 = 0.6;
+
+/// Slack (mm) past a crown's own reach before a triangle nearer a neighbour's axis is the
+/// neighbour's.
+pub const NEIGHBOUR_SLACK_MM: f32 = 0.25;
+
+/// A neighbouring crown as the trim sees it: a point on its axis (the centre of its upper half,
+/// orthosim's frame) and its reach from that axis (half its widest anatomical dimension, mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrownAxis {
+    /// A point on the axis.
+    pub at: Vec3,
+    /// Half the crown's widest anatomical dimension (mm).
+    pub reach: f32,
+}
+
+impl CrownAxis {
+    /// The axis of raw crown `mesh` (orthosim's frame) whose occlusal direction is `occlusal`:
+    /// the centre of its vertices within half a crown length of its tip (which bleeding at the
+    /// margin does not reach). `None` for an empty mesh.
+    pub fn of(mesh: &TriMesh, an: &ToothAnatomy, occlusal: Vec3) -> Option<Self> {
+        if mesh.vertices.is_empty() {
+            return None;
+        }
+        let mut heights: Vec<f32> = mesh.vertices.iter().map(|v| v.dot(occlusal)).collect();
+        heights.sort_by(f32::total_cmp);
+        // The tip: high, but not a lone spike.
+        let tip = heights[((heights.len() - 1) as f32 * 0.99) as usize];
+        let (sum, n) = mesh
+            .vertices
+            .iter()
+            .filter(|v| v.dot(occlusal) >= tip - 0.5 * an.crown_length)
+            .fold((Vec3::ZERO, 0usize), |(s, n), v| (s + *v, n + 1));
+        (n > 0).then(|| Self {
+            at: sum / n as f32,
+            reach: 0.5 * an.mesiodistal.max(an.buccolingual),
+        })
+    }
+
+    /// Distance of `p` from this axis across `occlusal`, in units of the reach.
+    fn relative(&self, p: Vec3, occlusal: Vec3) -> f32 {
+        let d = p - self.at;
+        (d - occlusal * d.dot(occlusal)).length() / self.reach.max(1e-3)
+    }
+}
 
 /// One change to a scan's labels.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -222,13 +269,15 @@ fn edges_of(mesh: &TriMesh, ids: &[u32], t: usize) -> [(u32, u32); 3] {
 
 /// Leaves out the triangles of tooth `fdi`'s raw crown `mesh` (orthosim's frame) with a corner
 /// past the crown (see the module doc) that hang from an opening of the surface (a spike inside
-/// the crown is the repair's); `occlusal` is the tooth's occlusal direction. The fix says
-/// what was trimmed, `None` when nothing was.
+/// the crown is the repair's); `occlusal` is the tooth's occlusal direction and `neighbours` the
+/// axes of the crowns beside it in the arch. The fix says what was trimmed, `None` when nothing
+/// was.
 pub fn trim_bleed(
     mesh: &TriMesh,
     fdi: Fdi,
     an: &ToothAnatomy,
     occlusal: Vec3,
+    neighbours: &[CrownAxis],
 ) -> (TriMesh, Option<LabelFix>) {
     if mesh.vertices.is_empty() || mesh.triangles.is_empty() {
         return (mesh.clone(), None);
@@ -238,17 +287,11 @@ pub fn trim_bleed(
     // The tip: high, but not a lone spike.
     let tip = heights[((heights.len() - 1) as f32 * 0.99) as usize];
     let floor = tip - BLEED_HEIGHT * an.crown_length - BLEED_SLACK_MM;
-    // The axis through the crown's upper half, which bleeding at the margin does not reach.
-    let upper: Vec<Vec3> = mesh
-        .vertices
-        .iter()
-        .copied()
-        .filter(|v| v.dot(occlusal) >= tip - 0.5 * an.crown_length)
-        .collect();
-    if upper.is_empty() {
+    let Some(own) = CrownAxis::of(mesh, an, occlusal) else {
         return (mesh.clone(), None);
-    }
-    let axis = upper.iter().copied().sum::<Vec3>() / upper.len() as f32;
+    };
+    let axis = own.at;
+    let own_limit = (own.reach + NEIGHBOUR_SLACK_MM) / own.reach.max(1e-3);
     // The crown is widest at its contacts and narrows to the cervix: below the upper part the
     // limit is the cervix's.
     let reach = 0.5 * BLEED_WIDTH * an.mesiodistal.max(an.buccolingual) + BLEED_SLACK_MM;
@@ -264,7 +307,14 @@ pub fn trim_bleed(
         } else {
             reach
         };
-        height < floor || across.length() > limit
+        let relative = own.relative(p, occlusal);
+        height < floor
+            || across.length() > limit
+            || (height < neck
+                && relative > own_limit
+                && neighbours
+                    .iter()
+                    .any(|n| n.relative(p, occlusal) < relative))
     };
     let mut kept = Vec::with_capacity(mesh.triangles.len());
     let (mut cut, mut sum) = (0usize, Vec3::ZERO);
@@ -425,7 +475,7 @@ mod tests {
                 mesh.triangles.push([a, b + 12, a + 12]);
             }
         }
-        let (trimmed, fix) = trim_bleed(&mesh, fdi, &an, Vec3::Y);
+        let (trimmed, fix) = trim_bleed(&mesh, fdi, &an, Vec3::Y, &[]);
         let fix = fix.expect("the flap is trimmed");
         assert_eq!((fix.action, fix.label), ("trimmed", 41));
         assert_eq!(
@@ -441,13 +491,64 @@ mod tests {
         // A crown with nothing past it is left as it is, and so is one whose cap has a spike
         // (the repair smooths spikes; they hang from no opening).
         let mut crown = TriMesh::new(mesh.vertices.clone(), mesh.triangles[..24].to_vec());
-        assert!(trim_bleed(&crown, fdi, &an, Vec3::Y).1.is_none());
+        assert!(trim_bleed(&crown, fdi, &an, Vec3::Y, &[]).1.is_none());
         crown
             .vertices
             .push(Vec3::new(9.0, an.crown_length + 0.5, 0.0));
         crown
             .triangles
             .extend((0..12u32).map(|k| [36, (k + 1) % 12, k]));
-        assert!(trim_bleed(&crown, fdi, &an, Vec3::Y).1.is_none());
+        assert!(trim_bleed(&crown, fdi, &an, Vec3::Y, &[]).1.is_none());
+    }
+
+    #[test]
+    fn a_label_run_along_a_neighbour_is_trimmed_on_the_neighbours_side_only() {
+        let an = anatomy(Arch::Lower, ToothKind::CentralIncisor);
+        let fdi = Fdi::new(41).unwrap();
+        // A crown-sized column and, 2 mm below it, a flap 3.5 mm out all round: within the
+        // neck's own limit, but past the crown's reach where a neighbour stands 6 mm away.
+        let reach = 0.5 * an.mesiodistal.max(an.buccolingual);
+        let flap = reach + 0.5;
+        let mut mesh = TriMesh::default();
+        let rings = [(an.crown_length, 2.0), (0.0, 2.5), (-2.0, flap)];
+        let sides = 12;
+        for (y, r) in rings {
+            for k in 0..sides {
+                let a = k as f32 / sides as f32 * std::f32::consts::TAU;
+                mesh.vertices.push(Vec3::new(r * a.cos(), y, r * a.sin()));
+            }
+        }
+        for ring in 0..2u32 {
+            for k in 0..sides as u32 {
+                let (a, b) = (ring * 12 + k, ring * 12 + (k + 1) % 12);
+                mesh.triangles.push([a, b, b + 12]);
+                mesh.triangles.push([a, b + 12, a + 12]);
+            }
+        }
+        // Alone, the flap is the crown's.
+        assert!(trim_bleed(&mesh, fdi, &an, Vec3::Y, &[]).1.is_none());
+        let neighbour = CrownAxis {
+            at: Vec3::new(reach + 3.0, an.crown_length, 0.0),
+            reach,
+        };
+        let (trimmed, fix) = trim_bleed(&mesh, fdi, &an, Vec3::Y, &[neighbour]);
+        let fix = fix.expect("the flap under the neighbour is trimmed");
+        assert_eq!((fix.action, fix.label), ("trimmed", 41));
+        assert!(fix.at[0] > 0.0, "{:?}", fix.at);
+        // Nothing of the flap is left on the neighbour's side, all of it on the other side.
+        let low: Vec<Vec3> = trimmed
+            .vertices
+            .iter()
+            .copied()
+            .filter(|v| v.y < -1.0)
+            .collect();
+        assert!(low.iter().all(|v| v.x < 0.5 * flap), "{low:?}");
+        assert_eq!(low.iter().filter(|v| v.x < -1.0).count(), 5, "{low:?}");
+        // A neighbour far off leaves it alone.
+        let far = CrownAxis {
+            at: Vec3::new(30.0, 0.0, 0.0),
+            reach,
+        };
+        assert!(trim_bleed(&mesh, fdi, &an, Vec3::Y, &[far]).1.is_none());
     }
 }
