@@ -86,6 +86,7 @@
 //! ```
 
 pub mod analysis;
+pub mod appliance;
 pub mod collision;
 pub mod geometry;
 pub mod io;

@@ -8,13 +8,14 @@ use std::{
 };
 
 /// Layers, lowest first: a module may use only the ones before it (and itself).
-const ORDER: [&str; 12] = [
+const ORDER: [&str; 13] = [
     "geometry",
     "io",
     "parallel",
     "teeth",
     "sphere_tree",
     "collision",
+    "appliance",
     "simulation",
     "movement",
     "analysis",

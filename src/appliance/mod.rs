@@ -1,0 +1,17 @@
+//! Appliances: what delivers the forces that move teeth. Brackets and tubes bonded on the crowns
+//! hold an archwire; the wire, bent out of its passive arch form by the teeth's malalignment,
+//! pushes back on each bracket with a force and a moment that fade as the teeth align.
+//!
+//! Engine-free (no ECS): the wire's cross-sections ([`section`]), alloys ([`material`]), the
+//! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses.
+
+pub mod banded;
+pub mod material;
+pub mod prescription;
+pub mod rod;
+pub mod section;
+
+pub use material::{Transformation, WireMaterial};
+pub use prescription::{BracketAngles, Prescription};
+pub use rod::{Equilibrium, Holder, NodeLoad, Reaction, Rod, RodNode, Settings};
+pub use section::{SectionProperties, SizeError, WireSize};
