@@ -14,6 +14,8 @@
 //! | `sigma2_over_root_length2` | σ²/h², σ² = y·d at M/F = 0 | 0.056 (cone) – 0.068 (paraboloid); accepted 0.050–0.075 |
 //! | `crown_displacement_mm_5n` | upper lateral incisor: initial displacement of the incisal edge under 5 N lingual at the bracket, bilinear ligament | 0.175 mm (AADR 2012, in vivo and FE); accepted 0.12–0.23 |
 //! | `canine_retraction_mm_per_month_1n` | upper canine, first premolar extracted, 1 N distal on a rectangular wire: distal travel of its crown in 30 days | 0.71 mm (Monini et al. 2019, maxilla); accepted 0.6–0.8 |
+//! | `wire_three_point_stiffness_n_per_mm` | the archwire rod, 0.016" steel, centre-loaded on a 10 mm span | 48EI/L³ ± 10 % ([`super::appliance_rows`]) |
+//! | `niti_unloading_force_n` | the rod, 0.016" NiTi, three-bracket test (7 mm spans) unloading at 2 mm after 3.1 mm | 0.8–1.8 N (Materials Research 2015: 98–151 gf) |
 //!
 //! h is the root length below the crest. `reference` in the output is the accepted range: the
 //! published one with the tolerance the row's source states. The canine row is what the
@@ -44,7 +46,7 @@ pub const SIGMA2_ACCEPTED: [f64; 2] = [0.050, 0.075];
 pub struct ValidationRow {
     /// What is measured (a fixed key).
     pub name: &'static str,
-    /// FDI number of the tooth.
+    /// FDI number of the tooth (0 for the archwire's rows, which measure a wire alone).
     pub tooth: u8,
     /// Moment-to-force ratio at the bracket (mm), where the row has one.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -263,6 +265,7 @@ pub fn validate(
         reference: Some([0.6, 0.8]),
         source: "0.71 mm/month at 100 g, maxilla (Monini et al., Angle Orthod 2019;89:559); β is calibrated on it; ±0.1 mm",
     });
+    rows.extend(super::appliance_rows::rows());
     Ok(Validation {
         model: "pdl",
         vertices: resolution.vertices,

@@ -6,6 +6,7 @@
 //! molar relation of the teeth present), [`plot`] (the paper's distance figures)
 //! and [`report`] (`orthosim report`: every case under every method, to JSON, CSV, plots and HTML).
 
+pub mod appliance_rows;
 pub mod biomechanics;
 pub mod bite;
 pub mod bite_bench;

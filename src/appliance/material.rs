@@ -1,22 +1,26 @@
 //! Archwire alloys: stainless steel, β-titanium (TMA), superelastic and copper NiTi.
 //!
 //! Steel and TMA are linear elastic up to their yield (which orthodontic activations stay below;
-//! orthosim does not model permanent set). Superelastic NiTi follows a flag-shaped law in bending:
-//! austenite's modulus up to the loading plateau, a near-flat plateau while it transforms, and on
-//! the way back a lower (unloading) plateau, so a deflected NiTi wire pushes teeth with the
-//! unloading plateau's force, nearly constant over millimetres of movement. The law is written on
-//! the bending curvature's magnitude, as moment over the section's elastic moment
-//! ([`WireMaterial::bending_scale`]); see `rod.rs` for how the rod uses it.
+//! orthosim does not model permanent set). Superelastic NiTi follows a flag-shaped stress–strain
+//! law: austenite's modulus up to the loading plateau, a near-flat plateau while it transforms to
+//! martensite, and on the way back a lower (unloading) plateau, so a deflected NiTi wire pushes
+//! teeth with a force nearly constant over millimetres of movement. Each fibre of the section
+//! follows the law from its own peak strain; the bending moment is the law integrated over the
+//! section (round: a circle; rectangular: its height), given as a share of the elastic moment
+//! ([`WireMaterial::bending_scale`]). An element remembers the largest curvature it was bent to
+//! ([`Transformation`]) until it is back on the elastic line.
 //!
 //! Sources for the moduli: Kusy's wire property studies (steel 193–200 GPa nominal, measured wires
 //! about 20 % lower; orthosim takes 180 GPa), Burstone & Goldberg AJO 1980;77:121 (TMA 69–72 GPa;
-//! 69 GPa taken). NiTi's austenite modulus, plateau strains and the ratio of its plateaus are
-//! typical of orthodontic superelastic wires (austenite about 40 GPa, loading plateau from 1 %
-//! strain at about 390 MPa, unloading plateau about 0.4 of the loading plateau); the plateau
-//! heights are set so that a 0.016" wire in the three-bracket test (ISO 15841) unloads at about
-//! 1.0–1.5 N at 2 mm, as measured across brands (Materials Research 2015).
+//! 69 GPa taken). NiTi's flag (austenite 40 GPa, loading plateau from 1.25 % strain, unloading
+//! plateau at 0.6 of the loading plateau's stress, plateau end 6 %) is typical of orthodontic
+//! superelastic wires, its heights set so that a 0.016" wire in the three-bracket test (ISO 15841)
+//! unloads at about 1.0–1.5 N at 2 mm, as measured across brands (Materials Research 2015);
+//! copper NiTi's plateaus are lower.
 
 use serde::{Deserialize, Serialize};
+
+use super::section::WireSize;
 
 /// An archwire's alloy.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -89,71 +93,90 @@ impl WireMaterial {
         matches!(self, Self::NiTi | Self::CopperNiTi)
     }
 
-    /// The outer-fibre strains of the flag: (loading plateau starts, transformation complete),
-    /// and the plateaus' moments as shares of the elastic moment at the loading plateau's start:
-    /// (loading plateau, unloading plateau).
-    fn flag(self) -> ([f64; 2], [f64; 2]) {
+    /// The flag as strains (stress over austenite's modulus): where the loading plateau starts,
+    /// the unloading plateau's height as a share of the loading one's, and where transformation
+    /// ends.
+    fn flag(self) -> (f64, f64, f64) {
         match self {
-            Self::CopperNiTi => ([0.0085, 0.06], [1.0, 0.40]),
-            _ => ([0.0100, 0.06], [1.0, 0.40]),
+            Self::CopperNiTi => (0.0105, 0.55, 0.06),
+            _ => (0.0125, 0.60, 0.06),
         }
     }
 
-    /// The bending moment as a share of the linear-elastic moment `E I κ` at curvature magnitude
-    /// `curvature` (1/mm) for a section whose outer fibre lies `half_height` mm from its neutral
-    /// axis, given the element's transformation state: 1 for steel and TMA; for NiTi, below 1
-    /// once on a plateau (the loading plateau while the curvature exceeds the state's peak, else
-    /// the unloading branch). The plateaus rise by 5 % of the elastic slope (a flag's plateaus
-    /// are not quite flat), which also keeps the rod's equilibrium unique.
-    pub fn bending_scale(self, curvature: f64, half_height: f64, state: &Transformation) -> f64 {
-        if !self.superelastic() || curvature <= 0.0 {
-            return 1.0;
-        }
-        let ([load, _end], [m_load, m_unload]) = self.flag();
-        // The unloading plateau meets the elastic line where its moment is the elastic one.
-        let unload = m_unload * load;
-        let strain = curvature * half_height;
-        let slope = 0.05;
-        let peak = (state.peak_curvature * half_height).max(strain);
-        // Loading branch: elastic to `load`, then the plateau.
+    /// A fibre's stress over austenite's modulus (a strain) at `strain` (≥ 0) after a peak strain
+    /// of `peak`: elastic, then the loading plateau (rising by [`PLATEAU_SLOPE`] of the elastic
+    /// slope; past the transformation's end, by half of it); below the peak, the elastic line down
+    /// from the peak's stress to the unloading plateau, along it, and elastic again where it meets
+    /// the elastic line.
+    fn fibre(self, strain: f64, peak: f64) -> f64 {
+        let (load, ratio, end) = self.flag();
         let loading = |e: f64| {
             if e <= load {
                 e
+            } else if e <= end {
+                load + PLATEAU_SLOPE * (e - load)
             } else {
-                m_load * load + slope * (e - load)
+                load + PLATEAU_SLOPE * (end - load) + 0.5 * (e - end)
             }
         };
-        let moment = if strain >= peak - 1e-12 || peak <= load {
-            loading(strain)
-        } else {
-            // Unloading from `peak`: elastic drop until the unloading plateau, along it back to
-            // where it meets the elastic line at `unload`, then elastic.
-            let plateau = unload + slope * (strain - unload);
-            let back = loading(peak) - (peak - strain);
-            if strain <= unload {
-                strain
-            } else {
-                back.max(plateau)
-            }
-        };
-        (moment / strain).clamp(0.0, 1.0)
+        let peak = peak.max(strain);
+        if peak <= load || strain >= peak {
+            return loading(strain);
+        }
+        let unload = ratio * load;
+        if strain <= unload {
+            return strain;
+        }
+        let back = loading(peak) - (peak - strain);
+        let plateau = unload + PLATEAU_SLOPE * (strain - unload);
+        back.max(plateau).min(loading(strain))
     }
 
-    /// The element's state after it was bent to `curvature`.
-    pub fn advance(self, state: &mut Transformation, curvature: f64, half_height: f64) {
+    /// The bending moment as a share of the linear-elastic moment `E I κ` at curvature magnitude
+    /// `curvature` (1/mm) for a section of wire `size`, after the element's `state`: 1 for steel
+    /// and TMA; for NiTi, the flag integrated over the section (48 strips across its height).
+    pub fn bending_scale(self, curvature: f64, size: WireSize, state: &Transformation) -> f64 {
+        if !self.superelastic() || curvature <= 0.0 {
+            return 1.0;
+        }
+        let half = 0.5 * size.height_mm();
+        let (load, _, _) = self.flag();
+        if curvature.max(state.peak_curvature) * half <= load {
+            return 1.0;
+        }
+        let strips = 48;
+        let (mut moment, mut elastic) = (0.0, 0.0);
+        for k in 0..strips {
+            let y = half * (k as f64 + 0.5) / strips as f64;
+            let width = match size {
+                WireSize::Round(_) => (half * half - y * y).max(0.0).sqrt(),
+                WireSize::Rect(..) => 1.0,
+            };
+            let e = curvature * y;
+            moment += self.fibre(e, state.peak_curvature * y) * y * width;
+            elastic += e * y * width;
+        }
+        (moment / elastic).clamp(0.0, 1.0)
+    }
+
+    /// The element's state after it was bent to `curvature` with wire `size`.
+    pub fn advance(self, state: &mut Transformation, curvature: f64, size: WireSize) {
         if !self.superelastic() {
             return;
         }
-        let ([load, _], [_, m_unload]) = self.flag();
-        let unload = m_unload * load;
-        if curvature * half_height <= unload {
-            // Back on the elastic line: austenite again.
+        let (load, ratio, _) = self.flag();
+        if curvature * 0.5 * size.height_mm() <= ratio * load {
+            // Back on the elastic line in every fibre: austenite again.
             state.peak_curvature = curvature;
         } else {
             state.peak_curvature = state.peak_curvature.max(curvature);
         }
     }
 }
+
+/// Slope of NiTi's plateaus as a share of austenite's modulus (plateaus are not quite flat; the
+/// slope also keeps the wire's equilibrium unique).
+pub const PLATEAU_SLOPE: f64 = 0.02;
 
 #[cfg(test)]
 mod tests {
@@ -162,26 +185,27 @@ mod tests {
     #[test]
     fn steel_and_tma_are_linear_and_niti_makes_a_flag() {
         let fresh = Transformation::default();
+        let size = WireSize::Round(0.016);
+        let h = 0.5 * size.height_mm();
         assert_eq!(
-            WireMaterial::StainlessSteel.bending_scale(0.1, 0.2, &fresh),
+            WireMaterial::StainlessSteel.bending_scale(0.1, size, &fresh),
             1.0
         );
         let m = WireMaterial::NiTi;
-        let h = 0.2;
         // Elastic below the plateau.
-        assert!((m.bending_scale(0.004 / h, h, &fresh) - 1.0).abs() < 1e-12);
-        // On the loading plateau: the moment nearly flat.
-        let moment = |e: f64, s: &Transformation| m.bending_scale(e / h, h, s) * e;
+        assert!((m.bending_scale(0.008 / h, size, &fresh) - 1.0).abs() < 1e-12);
+        // On the loading plateau the moment rises slowly (the elastic core shrinks).
+        let moment = |e: f64, s: &Transformation| m.bending_scale(e / h, size, s) * e;
         let (a, b) = (moment(0.02, &fresh), moment(0.04, &fresh));
-        assert!(b > a && b < 1.2 * a, "{a} {b}");
-        // Unloading from 4 % strain: lower than loading at the same strain, and its own plateau.
+        assert!(b > a && b < 1.4 * a, "{a} {b}");
+        // Unloading from 4 % strain: lower than loading at the same strain.
         let mut state = Transformation::default();
-        m.advance(&mut state, 0.04 / h, h);
+        m.advance(&mut state, 0.04 / h, size);
         let (u2, u3) = (moment(0.02, &state), moment(0.03, &state));
-        assert!(u2 < 0.6 * a, "unloading {u2} against loading {a}");
-        assert!(u3 > u2 && u3 < 1.2 * u2, "{u2} {u3}");
-        // Back below the unloading plateau's end: elastic again.
-        assert!((m.bending_scale(0.003 / h, h, &state) - 1.0).abs() < 1e-12);
+        assert!(u2 < 0.7 * a, "unloading {u2} against loading {a}");
+        assert!(u3 > u2, "{u2} {u3}");
+        // Back on the elastic line below the unloading plateau.
+        assert!((m.bending_scale(0.004 / h, size, &state) - 1.0).abs() < 1e-9);
         // The moment never rises on the way back down.
         let mut last = f64::INFINITY;
         for k in (1..=40).rev() {

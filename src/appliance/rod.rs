@@ -271,11 +271,10 @@ impl Rod {
             c[i][i] = self.stiffness[i];
         }
         let bend = (d[4] * d[4] + d[5] * d[5]).sqrt();
-        let half = 0.5 * self.size.height_mm().max(self.size.width_mm());
-        let scale = self.material.bending_scale(bend, half, &e.state);
+        let scale = self.material.bending_scale(bend, self.size, &e.state);
         if scale < 1.0 && bend > 0.0 {
             // M = scale(κ)·EI·κ: EI·scale across the bend, EI·dM/dκ along it.
-            let moment = |k: f64| self.material.bending_scale(k, half, &e.state) * k;
+            let moment = |k: f64| self.material.bending_scale(k, self.size, &e.state) * k;
             let h = 1e-6 * bend;
             let slope = (moment(bend + h) - moment((bend - h).max(0.0))) / (2.0 * h);
             let n = [d[4] / bend, d[5] / bend];
@@ -485,12 +484,11 @@ impl Rod {
         }
         let converged = residual <= settings.tolerance_n;
         if converged && self.material.superelastic() {
-            let half = 0.5 * self.size.height_mm().max(self.size.width_mm());
             for i in 0..self.elements.len() {
                 let s = strains(&self.nodes[i], &self.nodes[i + 1], self.elements[i].length);
                 let e = &mut self.elements[i];
                 let bend = ((s[4] - e.rest[4]).powi(2) + (s[5] - e.rest[5]).powi(2)).sqrt();
-                self.material.advance(&mut e.state, bend, half);
+                self.material.advance(&mut e.state, bend, self.size);
             }
         }
         Equilibrium {
@@ -741,14 +739,14 @@ mod tests {
 
     #[test]
     fn niti_unloads_below_its_loading_force() {
-        let span = 10.0;
-        let mut rod = straight(span, 20, WireSize::Round(0.016), WireMaterial::NiTi);
+        let span = 14.0;
+        let mut rod = straight(span, 28, WireSize::Round(0.016), WireMaterial::NiTi);
         let left = Holder::pin(0, &rod.nodes[0].clone());
-        let mut right = Holder::pin(20, &rod.nodes[20].clone());
+        let mut right = Holder::pin(28, &rod.nodes[28].clone());
         right.play[0] = f64::INFINITY;
         // The middle node pushed to a depth by a stiff holder free to turn.
         let push = |rod: &mut Rod, depth: f64| {
-            let mut h = Holder::pin(10, &rod.nodes[10].clone());
+            let mut h = Holder::pin(14, &rod.nodes[14].clone());
             h.at = DVec3::new(0.5 * span, 0.0, -depth);
             h.play[0] = f64::INFINITY;
             let holders = [left, right, h];

@@ -62,18 +62,24 @@ fn print_table(t: &Validation) {
         t.model, t.vertices
     );
     println!(
-        "{:<34} {:>5} {:>5} {:>9} {:>17}  {:<24} source",
+        "{:<36} {:>5} {:>5} {:>9} {:>17}  {:<24} source",
         "quantity", "tooth", "M/F", "value", "reference", "unit"
     );
     for r in &t.rows {
         let mf = r.mf.map_or(String::new(), |m| format!("{m:.0}"));
+        // Rows of the archwire alone have no tooth.
+        let tooth = if r.tooth == 0 {
+            "wire".to_owned()
+        } else {
+            r.tooth.to_string()
+        };
         let reference = r
             .reference
             .map_or("—".to_owned(), |[lo, hi]| format!("{lo:.3}–{hi:.3}"));
         println!(
-            "{:<34} {:>5} {:>5} {:>9.3} {:>17}  {:<24} {}{}",
+            "{:<36} {:>5} {:>5} {:>9.3} {:>17}  {:<24} {}{}",
             r.name,
-            r.tooth,
+            tooth,
             mf,
             r.value,
             reference,

@@ -480,7 +480,11 @@ fn simulate_takes_either_model_and_validate_prints_its_rows() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "pdl");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 16);
+    assert_eq!(rows.len(), 18);
+    assert!(
+        rows.iter()
+            .any(|r| r["name"] == "niti_unloading_force_n" && r["tooth"] == 0)
+    );
     for r in rows {
         for key in ["name", "tooth", "value", "unit", "reference", "source"] {
             assert!(r.get(key).is_some(), "{key} missing: {r}");
