@@ -6,11 +6,13 @@
 //! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses.
 
 pub mod banded;
+pub mod bracket;
 pub mod material;
 pub mod prescription;
 pub mod rod;
 pub mod section;
 
+pub use bracket::{Bracket, Slot, ToothAxes, binding_angle_rad, torque_play_rad};
 pub use material::{Transformation, WireMaterial};
 pub use prescription::{BracketAngles, Prescription};
 pub use rod::{Equilibrium, Holder, NodeLoad, Reaction, Rod, RodNode, Settings};
