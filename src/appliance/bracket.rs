@@ -2,7 +2,8 @@
 //! and how much room the slot leaves a wire of a given size.
 //!
 //! **Slot frame** (in the tooth's local frame): X along the slot, the way the archwire runs (from
-//! the patient's right to left), Y across the slot's height (occlusal), Z out of the slot (buccal).
+//! the patient's right to left), Z out of the slot (buccal), Y = Z × X across the slot's height
+//! (upwards in both arches, so one wire frame convention serves both).
 //! A bracket is bonded at the crown's bracket point (on the buccal surface at the bracket height)
 //! with its slot [`BASE_MM`] plus the prescription's in-out out from the surface, and its slot
 //! turned so that a passive straight wire leaves the crown at the prescription's tip, torque and
@@ -123,13 +124,10 @@ pub struct Bracket {
     pub frame: DQuat,
 }
 
-/// The tooth's own directions a bracket is placed by (tooth frame, unit): its long axis
-/// (occlusal), its buccal direction, and the way the archwire runs past it (mesial on the
-/// patient's right, distal on the left).
+/// The tooth's own directions a bracket is placed by (tooth frame, unit): its buccal direction
+/// and the way the archwire runs past it (mesial on the patient's right, distal on the left).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToothAxes {
-    /// Long axis, towards the crown.
-    pub occlusal: DVec3,
     /// Buccal.
     pub buccal: DVec3,
     /// The wire's running direction.
@@ -239,7 +237,6 @@ mod tests {
     #[test]
     fn a_passive_prescription_wire_levels_the_crown_and_brackets_stand_out_by_their_in_out() {
         let axes = ToothAxes {
-            occlusal: DVec3::Y,
             buccal: DVec3::Z,
             along: DVec3::X,
             along_is_mesial: true,

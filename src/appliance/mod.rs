@@ -5,6 +5,7 @@
 //! Engine-free (no ECS): the wire's cross-sections ([`section`]), alloys ([`material`]), the
 //! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses.
 
+pub mod archwire;
 pub mod banded;
 pub mod bracket;
 pub mod material;
@@ -12,6 +13,7 @@ pub mod prescription;
 pub mod rod;
 pub mod section;
 
+pub use archwire::{ArchForm, ArchSize, Laid, lay};
 pub use bracket::{Bracket, Slot, ToothAxes, binding_angle_rad, torque_play_rad};
 pub use material::{Transformation, WireMaterial};
 pub use prescription::{BracketAngles, Prescription};
