@@ -7,6 +7,7 @@
 
 pub mod archwire;
 pub mod banded;
+pub mod bench;
 pub mod bracket;
 pub mod material;
 pub mod prescription;

@@ -186,7 +186,7 @@ pub struct Settings {
 impl Default for Settings {
     fn default() -> Self {
         Self {
-            tolerance_n: 1e-7,
+            tolerance_n: 1e-5,
             max_iterations: 60,
         }
     }

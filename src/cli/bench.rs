@@ -107,6 +107,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     };
     let pdl = pdl_bench(vertices, 200)?;
     let bite = bite_bench(vertices, 3)?;
+    let appliance = orthosim::appliance::bench::appliance_bench(20);
     if progress {
         eprintln!();
     }
@@ -117,11 +118,13 @@ pub fn run(args: BenchArgs) -> Result<()> {
             report: &'a bench::BenchReport,
             pdl: &'a PdlBench,
             bite: &'a BiteBench,
+            appliance: &'a orthosim::appliance::bench::ApplianceBench,
         }
         return print_json(&Output {
             report: &report,
             pdl: &pdl,
             bite: &bite,
+            appliance: &appliance,
         });
     }
     let tree = args.trees.tree;
@@ -173,6 +176,20 @@ pub fn run(args: BenchArgs) -> Result<()> {
         bite.settle_ms[1],
         bite.excursion_ms[0],
         bite.excursion_ms[1]
+    );
+    let a = &appliance;
+    println!(
+        "appliance ({} brackets, {}-node 0.014\" NiTi wire, {} runs{}): a step's solve {:.0} µs (median; {:.0}–{:.0}, {} Newton iterations), {:.1}× the full-mouth step; engaging the wire {:.0} µs",
+        a.brackets,
+        a.nodes,
+        a.runs,
+        if a.converged { "" } else { ", NOT CONVERGED" },
+        a.step_us[1],
+        a.step_us[0],
+        a.step_us[2],
+        a.step_iterations,
+        a.step_us[1] / report.full_mouth_step_us.max(1e-9),
+        a.engage_us[1]
     );
     Ok(())
 }
