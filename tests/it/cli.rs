@@ -619,7 +619,7 @@ fn report_writes_every_file_its_page_refers_to() {
     }
     assert_eq!(
         v["biomechanics"]["rows"].as_array().map(|r| r.len()),
-        Some(16)
+        Some(18)
     );
     assert!(html.contains("The bite") && html.contains("biomechanics"));
     let fit = v["tree_fit"].as_array().unwrap();
