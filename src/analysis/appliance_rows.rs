@@ -4,17 +4,11 @@
 use glam::DVec3;
 
 use super::biomechanics::ValidationRow;
-use crate::appliance::{Holder, Reaction, Rod, RodNode, Settings, WireMaterial, WireSize};
+use crate::appliance::{Holder, Reaction, Rod, Settings, WireMaterial, WireSize};
 
-/// A straight wire along x over `span` mm in `elements` elements.
+/// A straight wire along x over `span` mm, centred on the origin, in `elements` elements.
 fn straight(span: f64, elements: usize, size: WireSize, material: WireMaterial) -> Rod {
-    let nodes = (0..=elements)
-        .map(|i| {
-            let x = DVec3::new(span * i as f64 / elements as f64 - 0.5 * span, 0.0, 0.0);
-            RodNode::along(x, DVec3::X, DVec3::Y)
-        })
-        .collect();
-    Rod::new(nodes, size, material)
+    Rod::straight(DVec3::X * (-0.5 * span), span, elements, size, material)
 }
 
 /// A wire held at both ends as in a bending bench (in place, free to turn; one end free to slide)

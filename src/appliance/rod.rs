@@ -138,6 +138,24 @@ impl Holder {
         [d.x, d.y, d.z, t.x, t.y, t.z]
     }
 
+    /// The offsets' derivatives by the node's six increments (rows: offsets), by central
+    /// differences.
+    fn jacobian(&self, n: &RodNode) -> [[f64; 6]; 6] {
+        let mut jac = [[0.0; 6]; 6];
+        let mut d = [0.0; 6];
+        for col in 0..6 {
+            d.fill(0.0);
+            d[col] = STEP;
+            let plus = self.offsets(&n.moved(&d));
+            d[col] = -STEP;
+            let minus = self.offsets(&n.moved(&d));
+            for row in 0..6 {
+                jac[row][col] = (plus[row] - minus[row]) / (2.0 * STEP);
+            }
+        }
+        jac
+    }
+
     /// Generalised force of each offset: the stiffness times how far past its play it is.
     fn resultants(&self, c: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
         let mut f = [0.0; 6];
@@ -255,6 +273,25 @@ impl Rod {
         }
     }
 
+    /// A straight passive wire of `length` mm along +x from `from`, in `elements` elements (its
+    /// height across y): the wire of bench tests.
+    pub fn straight(
+        from: DVec3,
+        length: f64,
+        elements: usize,
+        size: WireSize,
+        material: WireMaterial,
+    ) -> Self {
+        let elements = elements.max(1);
+        let nodes = (0..=elements)
+            .map(|i| {
+                let x = from + DVec3::X * (length * i as f64 / elements as f64);
+                RodNode::along(x, DVec3::X, DVec3::Y)
+            })
+            .collect();
+        Self::new(nodes, size, material)
+    }
+
     /// The section's stiffnesses: EA, κGA, κGA (N), GJ, EI in the arch's plane, EI across it
     /// (N·mm²).
     pub fn stiffness(&self) -> [f64; 6] {
@@ -362,18 +399,7 @@ impl Rod {
             if f.iter().all(|v| *v == 0.0) && stiff.iter().all(|v| *v == 0.0) {
                 continue;
             }
-            let mut jac = [[0.0; 6]; 6];
-            let mut d = [0.0; 6];
-            for col in 0..6 {
-                d.fill(0.0);
-                d[col] = STEP;
-                let plus = h.offsets(&node.moved(&d));
-                d[col] = -STEP;
-                let minus = h.offsets(&node.moved(&d));
-                for row in 0..6 {
-                    jac[row][col] = (plus[row] - minus[row]) / (2.0 * STEP);
-                }
-            }
+            let jac = h.jacobian(&node);
             let base = h.node * DOF;
             for col in 0..6 {
                 g[base + col] += (0..6).map(|row| jac[row][col] * f[row]).sum::<f64>();
@@ -510,18 +536,9 @@ impl Rod {
                 let c = h.offsets(node);
                 let (f, _) = h.resultants(&c);
                 // The generalised forces on the node, back in the world frame.
-                let mut g = [0.0; 6];
-                let mut d = [0.0; 6];
-                for col in 0..6 {
-                    d.fill(0.0);
-                    d[col] = STEP;
-                    let plus = h.offsets(&node.moved(&d));
-                    d[col] = -STEP;
-                    let minus = h.offsets(&node.moved(&d));
-                    g[col] = (0..6)
-                        .map(|r| (plus[r] - minus[r]) / (2.0 * STEP) * f[r])
-                        .sum();
-                }
+                let jac = h.jacobian(node);
+                let g: [f64; 6] =
+                    std::array::from_fn(|col| (0..6).map(|r| jac[r][col] * f[r]).sum());
                 // The wire feels −g; the holder feels +g, its moment taken about the slot.
                 let force = DVec3::new(g[0], g[1], g[2]);
                 let moment = DVec3::new(g[3], g[4], g[5]) + (node.x - h.at).cross(force);

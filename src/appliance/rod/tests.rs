@@ -4,13 +4,7 @@ use super::*;
 
 /// A straight wire along X from 0 to `length`, `elements` elements.
 fn straight(length: f64, elements: usize, size: WireSize, m: WireMaterial) -> Rod {
-    let nodes = (0..=elements)
-        .map(|i| {
-            let x = DVec3::new(length * i as f64 / elements as f64, 0.0, 0.0);
-            RodNode::along(x, DVec3::X, DVec3::Y)
-        })
-        .collect();
-    Rod::new(nodes, size, m)
+    Rod::straight(DVec3::ZERO, length, elements, size, m)
 }
 
 fn load(node: usize, force: DVec3, moment: DVec3) -> NodeLoad {

@@ -453,28 +453,33 @@ mod tests {
         assert!(tidy_labels(&mut scan).is_empty());
     }
 
+    /// An open column of 12-sided rings (height, radius), joined by quads, open at both ends.
+    fn column(rings: &[(f32, f32)]) -> TriMesh {
+        let mut mesh = TriMesh::default();
+        let sides = 12u32;
+        for &(y, r) in rings {
+            for k in 0..sides {
+                let a = k as f32 / sides as f32 * std::f32::consts::TAU;
+                mesh.vertices.push(Vec3::new(r * a.cos(), y, r * a.sin()));
+            }
+        }
+        for ring in 0..rings.len() as u32 - 1 {
+            for k in 0..sides {
+                let (a, b) = (ring * sides + k, ring * sides + (k + 1) % sides);
+                mesh.triangles.push([a, b, b + sides]);
+                mesh.triangles.push([a, b + sides, a + sides]);
+            }
+        }
+        mesh
+    }
+
     #[test]
     fn a_label_run_into_the_gum_is_trimmed_back_to_the_crown() {
         let an = anatomy(Arch::Lower, ToothKind::CentralIncisor);
         let fdi = Fdi::new(41).unwrap();
         // A crown-sized column of quads from y = 0 to the crown length, and a flap of gum from
         // its foot out to 8 mm at 2 mm below it.
-        let mut mesh = TriMesh::default();
-        let rings = [(an.crown_length, 2.0), (0.0, 2.5), (-2.0, 8.0)];
-        let sides = 12;
-        for (y, r) in rings {
-            for k in 0..sides {
-                let a = k as f32 / sides as f32 * std::f32::consts::TAU;
-                mesh.vertices.push(Vec3::new(r * a.cos(), y, r * a.sin()));
-            }
-        }
-        for ring in 0..2u32 {
-            for k in 0..sides as u32 {
-                let (a, b) = (ring * 12 + k, ring * 12 + (k + 1) % 12);
-                mesh.triangles.push([a, b, b + 12]);
-                mesh.triangles.push([a, b + 12, a + 12]);
-            }
-        }
+        let mesh = column(&[(an.crown_length, 2.0), (0.0, 2.5), (-2.0, 8.0)]);
         let (trimmed, fix) = trim_bleed(&mesh, fdi, &an, Vec3::Y, &[]);
         let fix = fix.expect("the flap is trimmed");
         assert_eq!((fix.action, fix.label), ("trimmed", 41));
@@ -509,22 +514,7 @@ mod tests {
         // neck's own limit, but past the crown's reach where a neighbour stands 6 mm away.
         let reach = 0.5 * an.mesiodistal.max(an.buccolingual);
         let flap = reach + 0.5;
-        let mut mesh = TriMesh::default();
-        let rings = [(an.crown_length, 2.0), (0.0, 2.5), (-2.0, flap)];
-        let sides = 12;
-        for (y, r) in rings {
-            for k in 0..sides {
-                let a = k as f32 / sides as f32 * std::f32::consts::TAU;
-                mesh.vertices.push(Vec3::new(r * a.cos(), y, r * a.sin()));
-            }
-        }
-        for ring in 0..2u32 {
-            for k in 0..sides as u32 {
-                let (a, b) = (ring * 12 + k, ring * 12 + (k + 1) % 12);
-                mesh.triangles.push([a, b, b + 12]);
-                mesh.triangles.push([a, b + 12, a + 12]);
-            }
-        }
+        let mesh = column(&[(an.crown_length, 2.0), (0.0, 2.5), (-2.0, flap)]);
         // Alone, the flap is the crown's.
         assert!(trim_bleed(&mesh, fdi, &an, Vec3::Y, &[]).1.is_none());
         let neighbour = CrownAxis {
