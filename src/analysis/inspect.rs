@@ -4,7 +4,7 @@
 //! gaps and penetrations come from the exact mesh–mesh query
 //! ([`crate::geometry::mesh_separation`]).
 
-use bevy::math::Vec3;
+use glam::Vec3;
 use serde::Serialize;
 
 use crate::{
