@@ -34,6 +34,14 @@ impl Banded {
         }
     }
 
+    /// Adds `other` (of the same order and band) entry by entry.
+    pub fn add_matrix(&mut self, other: &Banded) {
+        debug_assert!(self.n == other.n && self.band == other.band);
+        for (a, b) in self.upper.iter_mut().zip(&other.upper) {
+            *a += b;
+        }
+    }
+
     /// Entry (`i`, `j`).
     pub fn get(&self, i: usize, j: usize) -> f64 {
         let (i, j) = if i <= j { (i, j) } else { (j, i) };
@@ -46,13 +54,24 @@ impl Banded {
 
     /// Solves `self · x = b` by banded Cholesky, in place of `b`. Returns false (and leaves `b`
     /// unspecified) when the matrix is not positive definite.
-    pub fn solve(mut self, b: &mut [f64]) -> bool {
+    pub fn solve(self, b: &mut [f64]) -> bool {
+        match self.factor() {
+            Some(f) => {
+                f.solve(b);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The Cholesky factor `self = Uᵀ·U`, to solve with many right-hand sides; `None` when the
+    /// matrix is not positive definite.
+    pub fn factor(mut self) -> Option<Factor> {
         let (n, w) = (self.n, self.band + 1);
-        // Factor: self = Uᵀ U, U upper banded, overwriting the band.
         for i in 0..n {
             let d = self.upper[i * w];
             if !(d > 0.0 && d.is_finite()) {
-                return false;
+                return None;
             }
             let d = d.sqrt();
             self.upper[i * w] = d;
@@ -70,25 +89,40 @@ impl Banded {
                 }
             }
         }
-        // Uᵀ y = b.
+        Some(Factor(self))
+    }
+}
+
+/// A banded Cholesky factor (see [`Banded::factor`]).
+#[derive(Clone, Debug)]
+pub struct Factor(Banded);
+
+impl Factor {
+    /// Order of the factored matrix.
+    pub fn order(&self) -> usize {
+        self.0.n
+    }
+
+    /// Solves `Uᵀ·U·x = b` in place of `b` (`b` as long as the order).
+    pub fn solve(&self, b: &mut [f64]) {
+        let u = &self.0;
+        let (n, w) = (u.n, u.band + 1);
         for i in 0..n {
-            let first = i.saturating_sub(self.band);
+            let first = i.saturating_sub(u.band);
             let mut s = b[i];
             for k in first..i {
-                s -= self.upper[k * w + (i - k)] * b[k];
+                s -= u.upper[k * w + (i - k)] * b[k];
             }
-            b[i] = s / self.upper[i * w];
+            b[i] = s / u.upper[i * w];
         }
-        // U x = y.
         for i in (0..n).rev() {
-            let last = (i + self.band).min(n - 1);
+            let last = (i + u.band).min(n - 1);
             let mut s = b[i];
             for k in i + 1..=last {
-                s -= self.upper[i * w + (k - i)] * b[k];
+                s -= u.upper[i * w + (k - i)] * b[k];
             }
-            b[i] = s / self.upper[i * w];
+            b[i] = s / u.upper[i * w];
         }
-        true
     }
 }
 

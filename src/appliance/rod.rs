@@ -19,22 +19,32 @@
 //! steel and TMA, the equilibrium is that of the discrete model, which converges to beam theory as
 //! elements shorten (one-point strain sampling: a cantilever's tip deflection within 1 % at 20
 //! elements; tests check cantilever, three-point bending and torsion). A wire in its passive
-//! shape, held where it lies, carries no force at all. The element Jacobians are central
-//! differences (step 10⁻⁶): exact to about 10⁻⁹ of the strains, far below any force reported.
+//! shape, held where it lies, carries no force at all. The strains' derivatives are exact (the
+//! rotation group's left Jacobian); the tangent is their Gauss–Newton part (it leaves out the
+//! stress resultants' geometric stiffness), so Newton converges linearly under large axial
+//! forces, which a line search on the energy keeps monotone.
 
-use glam::{DQuat, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 
-use super::banded::Banded;
+use super::banded::{Banded, Factor};
 use super::material::{Transformation, WireMaterial};
 use super::section::WireSize;
 
 /// Timoshenko's shear coefficient (round sections 0.9, rectangles 0.83; shear hardly matters in a
 /// slender wire).
 const SHEAR_FACTOR: f64 = 0.85;
-/// Central-difference step for the element Jacobians (mm and radians).
-const STEP: f64 = 1e-6;
+/// Forward-difference step for the geometric stiffness (mm and radians).
+const GEOMETRIC_STEP: f64 = 1e-6;
 /// Degrees of freedom per node: three of position, three of rotation.
 const DOF: usize = 6;
+
+/// The stiffness of the equilibrium equations in two parts: the material part JᵀCJ (positive
+/// semi-definite) and the geometric part Σ fᵢ∇²sᵢ (the stress resultants on the strains'
+/// curvature, indefinite under compression).
+struct Tangent {
+    material: Banded,
+    geometric: Banded,
+}
 
 /// One node of the wire: where it is and how its cross-section is turned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,6 +101,78 @@ fn strains(a: &RodNode, b: &RodNode, length: f64) -> [f64; 6] {
     [gamma.x, gamma.y, gamma.z, k.x, k.y, k.z]
 }
 
+/// Puts the 3×3 block `m` into rows `row..row + 3`, columns `col..col + 3` of `jac`.
+fn put(jac: &mut [[f64; 12]; 6], row: usize, col: usize, m: DMat3) {
+    for c in 0..3 {
+        let v = m.col(c);
+        for r in 0..3 {
+            jac[row + r][col + c] = v[r];
+        }
+    }
+}
+
+/// [`strains`] and their derivatives by the two nodes' twelve increments (position of `a`, turn
+/// of `a`, position of `b`, turn of `b`; turns as world rotation vectors applied on the left).
+fn strains_and_jacobian(a: &RodNode, b: &RodNode, length: f64) -> ([f64; 6], [[f64; 12]; 6]) {
+    let omega = log(a.q.inverse() * b.q);
+    let mid = DMat3::from_quat(a.q * DQuat::from_scaled_axis(0.5 * omega));
+    let ra = DMat3::from_quat(a.q);
+    let chord = b.x - a.x;
+    let inv = 1.0 / length;
+    let mt = mid.transpose();
+    let gamma = mt * chord * inv;
+    let k = omega * inv;
+    // ω = log(Raᵀ·Rb): dω = Jl⁻¹(ω)·Raᵀ·(dθb − dθa).
+    let turn = jl_inv(omega) * ra.transpose();
+    // The mean frame qa·exp(ω/2) turns by δ = dθa + ½·Ra·Jl(ω/2)·dω.
+    let half = ra * jl(0.5 * omega) * turn * 0.5;
+    // γ = Mᵀ·chord/L: dγ = Mᵀ·(dxb − dxa)/L + Mᵀ·[chord]×·δ/L.
+    let by_turn = mt * skew(chord) * inv;
+    let mut jac = [[0.0; 12]; 6];
+    put(&mut jac, 0, 0, mt * -inv);
+    put(&mut jac, 0, 6, mt * inv);
+    put(&mut jac, 0, 3, by_turn * (DMat3::IDENTITY - half));
+    put(&mut jac, 0, 9, by_turn * half);
+    put(&mut jac, 3, 3, turn * -inv);
+    put(&mut jac, 3, 9, turn * inv);
+    ([gamma.x, gamma.y, gamma.z, k.x, k.y, k.z], jac)
+}
+
+/// The cross-product matrix of `v`: `skew(v) * w == v.cross(w)`.
+fn skew(v: DVec3) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(0.0, v.z, -v.y),
+        DVec3::new(-v.z, 0.0, v.x),
+        DVec3::new(v.y, -v.x, 0.0),
+    )
+}
+
+/// The left Jacobian of the rotation group at `phi`: `exp(phi + d) ≈ exp(jl(phi)·d)·exp(phi)`.
+fn jl(phi: DVec3) -> DMat3 {
+    let t2 = phi.length_squared();
+    let s = skew(phi);
+    let (a, b) = if t2 < 1e-8 {
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    DMat3::IDENTITY + s * a + s * s * b
+}
+
+/// The inverse of [`jl`]: `log(exp(d)·exp(phi)) ≈ phi + jl_inv(phi)·d`.
+fn jl_inv(phi: DVec3) -> DMat3 {
+    let t2 = phi.length_squared();
+    let s = skew(phi);
+    let c = if t2 < 1e-8 {
+        1.0 / 12.0 + t2 / 720.0
+    } else {
+        let t = t2.sqrt();
+        1.0 / t2 - (1.0 + t.cos()) / (2.0 * t * t.sin())
+    };
+    DMat3::IDENTITY - s * 0.5 + s * s * c
+}
+
 /// What holds a node of the wire: a bracket's slot, a tube, a clamp. Its frame's X runs along
 /// the slot (the way the wire runs), Y across the slot's height, Z into its depth. Each of the
 /// node's six offsets from the holder (three of position, three of rotation, in the holder's
@@ -138,19 +220,17 @@ impl Holder {
         [d.x, d.y, d.z, t.x, t.y, t.z]
     }
 
-    /// The offsets' derivatives by the node's six increments (rows: offsets), by central
-    /// differences.
+    /// The offsets' derivatives by the node's six increments (rows: offsets): the holder's
+    /// frame turns positions; a turn's rotation vector moves by Jl⁻¹ of itself.
     fn jacobian(&self, n: &RodNode) -> [[f64; 6]; 6] {
+        let inv = DMat3::from_quat(self.frame.inverse());
+        let t = log(self.frame.inverse() * n.q);
+        let turn = jl_inv(t) * inv;
         let mut jac = [[0.0; 6]; 6];
-        let mut d = [0.0; 6];
-        for col in 0..6 {
-            d.fill(0.0);
-            d[col] = STEP;
-            let plus = self.offsets(&n.moved(&d));
-            d[col] = -STEP;
-            let minus = self.offsets(&n.moved(&d));
-            for row in 0..6 {
-                jac[row][col] = (plus[row] - minus[row]) / (2.0 * STEP);
+        for c in 0..3 {
+            for r in 0..3 {
+                jac[r][c] = inv.col(c)[r];
+                jac[3 + r][3 + c] = turn.col(c)[r];
             }
         }
         jac
@@ -233,6 +313,9 @@ pub struct Rod {
     pub material: WireMaterial,
     /// EA, κGA, κGA, GJ, EI about the height axis (in-plane), EI about the width axis.
     stiffness: [f64; 6],
+    /// The last tangent's factor, reused from iteration to iteration and solve to solve while it
+    /// still converges fast: a simulation's brackets move little between solves.
+    factor: Option<Factor>,
 }
 
 impl Rod {
@@ -270,6 +353,7 @@ impl Rod {
             size,
             material,
             stiffness,
+            factor: None,
         }
     }
 
@@ -340,53 +424,63 @@ impl Rod {
         holders: &[Holder],
         loads: &[NodeLoad],
         tangent: bool,
-    ) -> (Vec<f64>, Option<Banded>) {
+    ) -> (Vec<f64>, Option<Tangent>) {
         let n = self.nodes.len() * DOF;
         let mut g = vec![0.0; n];
-        let mut k = tangent.then(|| Banded::zeros(n, 2 * DOF - 1));
+        let mut k = tangent.then(|| Tangent {
+            material: Banded::zeros(n, 2 * DOF - 1),
+            geometric: Banded::zeros(n, 2 * DOF - 1),
+        });
         for (i, e) in self.elements.iter().enumerate() {
             let (a, b) = (self.nodes[i], self.nodes[i + 1]);
-            let s = strains(&a, &b, e.length);
+            let (s, jac) = strains_and_jacobian(&a, &b, e.length);
             let (f, stiff) = self.resultants(e, &s);
-            // J: 6 strains × 12 degrees of freedom, by central differences.
-            let mut jac = [[0.0; 12]; 6];
-            let mut d = [0.0; 6];
-            for col in 0..12 {
-                let node = col / DOF;
-                d.fill(0.0);
-                d[col % DOF] = STEP;
-                let plus = if node == 0 {
-                    strains(&a.moved(&d), &b, e.length)
-                } else {
-                    strains(&a, &b.moved(&d), e.length)
-                };
-                d[col % DOF] = -STEP;
-                let minus = if node == 0 {
-                    strains(&a.moved(&d), &b, e.length)
-                } else {
-                    strains(&a, &b.moved(&d), e.length)
-                };
-                for row in 0..6 {
-                    jac[row][col] = (plus[row] - minus[row]) / (2.0 * STEP);
-                }
-            }
             let base = i * DOF;
+            let own: [f64; 12] =
+                std::array::from_fn(|col| (0..6).map(|row| jac[row][col] * f[row]).sum::<f64>());
             for col in 0..12 {
-                let mut v = 0.0;
-                for row in 0..6 {
-                    v += jac[row][col] * f[row];
-                }
-                g[base + col] += e.length * v;
+                g[base + col] += e.length * own[col];
             }
-            if let Some(k) = k.as_mut() {
+            if let Some(Tangent {
+                material: k,
+                geometric,
+            }) = k.as_mut()
+            {
+                // The resultants held, the strains' curvature: forward differences of Jᵀ·f,
+                // made symmetric.
+                let mut geo = [[0.0; 12]; 12];
+                for (col, column) in geo.iter_mut().enumerate() {
+                    let mut d = [0.0; DOF];
+                    d[col % DOF] = GEOMETRIC_STEP;
+                    let (_, moved) = if col < DOF {
+                        strains_and_jacobian(&a.moved(&d), &b, e.length)
+                    } else {
+                        strains_and_jacobian(&a, &b.moved(&d), e.length)
+                    };
+                    for (c1, v) in column.iter_mut().enumerate() {
+                        let turned: f64 = (0..6).map(|row| moved[row][c1] * f[row]).sum();
+                        *v = e.length * (turned - own[c1]) / GEOMETRIC_STEP;
+                    }
+                }
                 for c1 in 0..12 {
                     for c2 in c1..12 {
-                        let mut v = 0.0;
-                        for r1 in 0..6 {
-                            for r2 in 0..6 {
-                                v += jac[r1][c1] * stiff[r1][r2] * jac[r2][c2];
+                        geometric.add(base + c1, base + c2, 0.5 * (geo[c1][c2] + geo[c2][c1]));
+                    }
+                }
+                // C·J first (C is diagonal but for NiTi's two bending strains), then Jᵀ·(C·J).
+                let mut cj = [[0.0; 12]; 6];
+                for (r1, row) in cj.iter_mut().enumerate() {
+                    for (r2, c) in stiff[r1].iter().enumerate() {
+                        if *c != 0.0 {
+                            for (v, j) in row.iter_mut().zip(&jac[r2]) {
+                                *v += c * j;
                             }
                         }
+                    }
+                }
+                for c1 in 0..12 {
+                    for c2 in c1..12 {
+                        let v: f64 = (0..6).map(|r| jac[r][c1] * cj[r][c2]).sum();
                         k.add(base + c1, base + c2, e.length * v);
                     }
                 }
@@ -404,7 +498,26 @@ impl Rod {
             for col in 0..6 {
                 g[base + col] += (0..6).map(|row| jac[row][col] * f[row]).sum::<f64>();
             }
-            if let Some(k) = k.as_mut() {
+            if let Some(Tangent {
+                material: k,
+                geometric,
+            }) = k.as_mut()
+            {
+                let mut geo = [[0.0; 6]; 6];
+                for (col, column) in geo.iter_mut().enumerate() {
+                    let mut d = [0.0; DOF];
+                    d[col] = GEOMETRIC_STEP;
+                    let moved = h.jacobian(&node.moved(&d));
+                    for (c1, v) in column.iter_mut().enumerate() {
+                        let turned: f64 = (0..6).map(|r| (moved[r][c1] - jac[r][c1]) * f[r]).sum();
+                        *v = turned / GEOMETRIC_STEP;
+                    }
+                }
+                for c1 in 0..6 {
+                    for c2 in c1..6 {
+                        geometric.add(base + c1, base + c2, 0.5 * (geo[c1][c2] + geo[c2][c1]));
+                    }
+                }
                 for c1 in 0..6 {
                     for c2 in c1..6 {
                         let v: f64 = (0..6).map(|r| jac[r][c1] * stiff[r] * jac[r][c2]).sum();
@@ -423,6 +536,35 @@ impl Rod {
         (g, k)
     }
 
+    /// The tangent at the wire as it stands, factored: Newton's full tangent where it is positive
+    /// definite (a wire not buckling), otherwise its material part alone, still a descent
+    /// direction. A little of the diagonal keeps a wire free within its play solvable: it stays
+    /// where it is in the directions nothing holds.
+    fn tangent_factor(
+        &self,
+        holders: &[Holder],
+        loads: &[NodeLoad],
+        geometric_too: bool,
+    ) -> Option<Factor> {
+        let Tangent {
+            material: mut k,
+            geometric,
+        } = self.assemble(holders, loads, true).1?;
+        let n = k.order();
+        let largest = (0..n).map(|i| k.get(i, i)).fold(0.0f64, f64::max).max(1.0);
+        for i in 0..n {
+            k.add(i, i, 1e-10 * largest + 1e-9);
+        }
+        if geometric_too {
+            let mut full = k.clone();
+            full.add_matrix(&geometric);
+            if let Some(f) = full.factor() {
+                return Some(f);
+            }
+        }
+        k.factor()
+    }
+
     /// Brings the wire to equilibrium in its `holders` under `loads`, starting from where it
     /// stands, then records each NiTi element's transformation.
     pub fn solve(
@@ -432,24 +574,32 @@ impl Rod {
         settings: &Settings,
     ) -> Equilibrium {
         let worst = |g: &[f64]| g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let (mut g, _) = self.assemble(holders, loads, false);
+        let mut g = self.assemble(holders, loads, false).0;
         let mut residual = worst(&g);
         let mut iterations = 0;
+        if self.factor.as_ref().map(Factor::order) != Some(g.len()) {
+            self.factor = None;
+        }
+        // The material part of the tangent alone (Gauss–Newton: a descent direction wherever
+        // the wire stands) until a full step is taken, then Newton's full tangent for its
+        // quadratic convergence near equilibrium, back to the material part when a step is cut
+        // short.
+        let mut geometric_too = false;
         while residual > settings.tolerance_n && iterations < settings.max_iterations {
             iterations += 1;
-            let (_, Some(mut k)) = self.assemble(holders, loads, true) else {
-                break;
-            };
-            // A little of the diagonal keeps a wire free within its play solvable: it stays
-            // where it is in the directions nothing holds.
-            let n = k.order();
-            let largest = (0..n).map(|i| k.get(i, i)).fold(0.0f64, f64::max).max(1.0);
-            for i in 0..n {
-                k.add(i, i, 1e-10 * largest + 1e-9);
-            }
             let mut step: Vec<f64> = g.iter().map(|v| -v).collect();
-            if !k.solve(&mut step) {
-                break;
+            match &self.factor {
+                Some(f) => f.solve(&mut step),
+                None => step.fill(0.0),
+            }
+            let descends = g.iter().zip(&step).map(|(a, b)| a * b).sum::<f64>() < 0.0;
+            if self.factor.is_none() || !descends {
+                let Some(f) = self.tangent_factor(holders, loads, geometric_too) else {
+                    break;
+                };
+                step = g.iter().map(|v| -v).collect();
+                f.solve(&mut step);
+                self.factor = Some(f);
             }
             // At most 1 mm or 0.3 rad at once; then along the step to where the energy stops
             // falling: the residual is the energy's gradient, so its projection on the step is
@@ -459,13 +609,11 @@ impl Rod {
                 m.max(v.abs() / limit)
             });
             let dot = |g: &[f64]| g.iter().zip(&step).map(|(a, b)| a * b).sum::<f64>();
+            let before = residual;
             let start = self.nodes.clone();
             let at = |rod: &mut Self, alpha: f64| {
                 for (i, node) in rod.nodes.iter_mut().enumerate() {
-                    let d: Vec<f64> = step[i * DOF..(i + 1) * DOF]
-                        .iter()
-                        .map(|v| alpha * v)
-                        .collect();
+                    let d: [f64; DOF] = std::array::from_fn(|j| alpha * step[i * DOF + j]);
                     *node = start[i].moved(&d);
                 }
                 rod.assemble(holders, loads, false).0
@@ -485,16 +633,16 @@ impl Rod {
                 let width = hi - lo;
                 let guess = lo - s_lo * width / (s_hi - s_lo);
                 let alpha = guess.clamp(lo + 0.05 * width, hi - 0.05 * width);
-                let g_alpha = at(self, alpha);
-                let s_alpha = dot(&g_alpha);
+                let at_alpha = at(self, alpha);
+                let s_alpha = dot(&at_alpha);
                 if s_alpha < 0.0 {
                     (lo, s_lo) = (alpha, s_alpha);
                     if s_alpha.abs() < 0.05 * slope0.abs() {
-                        (hi, trial, s_hi) = (alpha, g_alpha, s_alpha);
+                        (hi, trial, s_hi) = (alpha, at_alpha, s_alpha);
                         break;
                     }
                 } else {
-                    (hi, trial, s_hi) = (alpha, g_alpha, s_alpha);
+                    (hi, trial, s_hi) = (alpha, at_alpha, s_alpha);
                 }
             }
             if s_hi > 0.0 && s_hi.abs() >= 0.05 * slope0.abs() {
@@ -507,6 +655,12 @@ impl Rod {
             let _ = hi;
             g = trial;
             residual = worst(&g);
+            // The tangent is kept while its full steps quarter the residual; otherwise the next
+            // iteration builds it afresh where the wire now stands.
+            if hi < 1.0 || residual > 0.25 * before {
+                self.factor = None;
+            }
+            geometric_too = hi >= 1.0;
         }
         let converged = residual <= settings.tolerance_n;
         if converged && self.material.superelastic() {

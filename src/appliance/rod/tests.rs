@@ -218,3 +218,69 @@ fn niti_unloads_below_its_loading_force() {
         "{unloading_1} {unloading_2}"
     );
 }
+
+/// Central differences of `f` by the twelve increments of two nodes.
+fn differences<const R: usize>(
+    a: &RodNode,
+    b: &RodNode,
+    f: impl Fn(&RodNode, &RodNode) -> [f64; R],
+) -> Vec<[f64; R]> {
+    let h = 1e-6;
+    (0..12)
+        .map(|col| {
+            let mut d = [0.0; 6];
+            d[col % 6] = h;
+            let plus = if col < 6 {
+                f(&a.moved(&d), b)
+            } else {
+                f(a, &b.moved(&d))
+            };
+            d[col % 6] = -h;
+            let minus = if col < 6 {
+                f(&a.moved(&d), b)
+            } else {
+                f(a, &b.moved(&d))
+            };
+            std::array::from_fn(|r| (plus[r] - minus[r]) / (2.0 * h))
+        })
+        .collect()
+}
+
+#[test]
+fn the_strains_derivatives_match_differences_even_at_large_turns() {
+    for (turn, tilt) in [(0.0, 0.0), (0.05, 0.3), (1.2, -0.7), (2.5, 1.0)] {
+        let a = RodNode::along(
+            DVec3::new(1.0, -2.0, 0.5),
+            DVec3::new(1.0, 0.2, -0.1),
+            DVec3::Y,
+        );
+        let q = DQuat::from_scaled_axis(DVec3::new(tilt, turn, 0.3 * turn)) * a.q;
+        let b = RodNode {
+            x: a.x + DVec3::new(0.9, 0.3, -0.2),
+            q,
+        };
+        let (_, jac) = strains_and_jacobian(&a, &b, 1.1);
+        let fd = differences(&a, &b, |a, b| strains(a, b, 1.1));
+        for (col, d) in fd.iter().enumerate() {
+            for row in 0..6 {
+                assert!(
+                    (jac[row][col] - d[row]).abs() < 1e-6,
+                    "turn {turn}: d strain {row} / d {col}: {} vs {}",
+                    jac[row][col],
+                    d[row]
+                );
+            }
+        }
+        let holder = Holder::clamp(0, &a);
+        let hj = holder.jacobian(&b);
+        let fd = differences(&b, &a, |b, _| holder.offsets(b));
+        for col in 0..6 {
+            for row in 0..6 {
+                assert!(
+                    (hj[row][col] - fd[col][row]).abs() < 1e-6,
+                    "holder {row} {col}"
+                );
+            }
+        }
+    }
+}
