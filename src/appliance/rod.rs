@@ -35,6 +35,8 @@ use super::section::WireSize;
 const SHEAR_FACTOR: f64 = 0.85;
 /// Forward-difference step for the geometric stiffness (mm and radians).
 const GEOMETRIC_STEP: f64 = 1e-6;
+/// Width over which a holder's wall comes into play (mm for offsets, radians for turns).
+pub const EDGE_BLEND: f64 = 1e-2;
 /// Degrees of freedom per node: three of position, three of rotation.
 const DOF: usize = 6;
 
@@ -236,16 +238,30 @@ impl Holder {
         jac
     }
 
-    /// Generalised force of each offset: the stiffness times how far past its play it is.
+    /// Generalised force of each offset: the stiffness times how far past its play it is, and
+    /// its derivative. The edge of a play is rounded over [`EDGE_BLEND`] (a quadratic blend: a
+    /// force of a thousandth of a newton where a wire just meets a wall), so the force's
+    /// derivative has no jump for Newton's method to chatter on; a clamp (no play) is linear
+    /// through zero.
     fn resultants(&self, c: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
         let mut f = [0.0; 6];
         let mut k = [0.0; 6];
         for i in 0..6 {
-            let excess = c[i].abs() - self.play[i];
-            // At the edge of the play (a clamp's is zero) the holder already resists.
-            if excess >= 0.0 {
-                f[i] = self.stiffness[i] * excess * c[i].signum();
-                k[i] = self.stiffness[i];
+            let (play, stiff) = (self.play[i], self.stiffness[i]);
+            if play <= 0.0 {
+                f[i] = stiff * c[i];
+                k[i] = stiff;
+                continue;
+            }
+            let w = EDGE_BLEND.min(play);
+            let excess = c[i].abs() - play;
+            if excess >= 0.5 * w {
+                f[i] = stiff * excess * c[i].signum();
+                k[i] = stiff;
+            } else if excess > -0.5 * w {
+                let into = excess + 0.5 * w;
+                f[i] = stiff * into * into / (2.0 * w) * c[i].signum();
+                k[i] = stiff * into / w;
             }
         }
         (f, k)
@@ -418,16 +434,17 @@ impl Rod {
     }
 
     /// The residual (internal less external generalised forces per degree of freedom) and, when
-    /// asked, the tangent stiffness.
+    /// asked (`Some`), the tangent stiffness, with its geometric part when `Some(true)`.
     fn assemble(
         &self,
         holders: &[Holder],
         loads: &[NodeLoad],
-        tangent: bool,
+        tangent: Option<bool>,
     ) -> (Vec<f64>, Option<Tangent>) {
+        let geometric_too = tangent == Some(true);
         let n = self.nodes.len() * DOF;
         let mut g = vec![0.0; n];
-        let mut k = tangent.then(|| Tangent {
+        let mut k = tangent.map(|_| Tangent {
             material: Banded::zeros(n, 2 * DOF - 1),
             geometric: Banded::zeros(n, 2 * DOF - 1),
         });
@@ -449,7 +466,7 @@ impl Rod {
                 // The resultants held, the strains' curvature: forward differences of Jᵀ·f,
                 // made symmetric.
                 let mut geo = [[0.0; 12]; 12];
-                for (col, column) in geo.iter_mut().enumerate() {
+                for (col, column) in geo.iter_mut().enumerate().filter(|_| geometric_too) {
                     let mut d = [0.0; DOF];
                     d[col % DOF] = GEOMETRIC_STEP;
                     let (_, moved) = if col < DOF {
@@ -504,7 +521,7 @@ impl Rod {
             }) = k.as_mut()
             {
                 let mut geo = [[0.0; 6]; 6];
-                for (col, column) in geo.iter_mut().enumerate() {
+                for (col, column) in geo.iter_mut().enumerate().filter(|_| geometric_too) {
                     let mut d = [0.0; DOF];
                     d[col] = GEOMETRIC_STEP;
                     let moved = h.jacobian(&node.moved(&d));
@@ -549,7 +566,7 @@ impl Rod {
         let Tangent {
             material: mut k,
             geometric,
-        } = self.assemble(holders, loads, true).1?;
+        } = self.assemble(holders, loads, Some(geometric_too)).1?;
         let n = k.order();
         let largest = (0..n).map(|i| k.get(i, i)).fold(0.0f64, f64::max).max(1.0);
         for i in 0..n {
@@ -574,7 +591,7 @@ impl Rod {
         settings: &Settings,
     ) -> Equilibrium {
         let worst = |g: &[f64]| g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut g = self.assemble(holders, loads, false).0;
+        let mut g = self.assemble(holders, loads, None).0;
         let mut residual = worst(&g);
         let mut iterations = 0;
         if self.factor.as_ref().map(Factor::order) != Some(g.len()) {
@@ -616,7 +633,7 @@ impl Rod {
                     let d: [f64; DOF] = std::array::from_fn(|j| alpha * step[i * DOF + j]);
                     *node = start[i].moved(&d);
                 }
-                rod.assemble(holders, loads, false).0
+                rod.assemble(holders, loads, None).0
             };
             let slope0 = dot(&g);
             if slope0 >= 0.0 {
@@ -697,6 +714,57 @@ impl Rod {
                 let force = DVec3::new(g[0], g[1], g[2]);
                 let moment = DVec3::new(g[3], g[4], g[5]) + (node.x - h.at).cross(force);
                 Reaction { force, moment }
+            })
+            .collect()
+    }
+
+    /// The stiffness each holder meets when it moves and the wire follows to its new
+    /// equilibrium (world; rows: force, then moment on the holder; columns: its translation, then
+    /// its turn), from the material tangent where the wire stands (kept for the next solve): the
+    /// holder's own walls in series with the rest of the wire, `A − A·S·A` for the holder's
+    /// stiffness `A` at its node and the node's block `S` of the tangent's inverse. Zero for a
+    /// holder the wire does not bear on. Exact to first order about the last equilibrium.
+    pub fn holder_stiffness(&mut self, holders: &[Holder]) -> Vec<[[f64; 6]; 6]> {
+        let n = self.nodes.len() * DOF;
+        // A fresh material tangent where the wire stands: a stale one may lack walls the wire
+        // now bears on (its inverse would then exceed the walls' and the result turn negative).
+        self.factor = self.tangent_factor(holders, &[], false);
+        holders
+            .iter()
+            .map(|h| {
+                let mut out = [[0.0; 6]; 6];
+                let (Some(f), Some(node)) = (&self.factor, self.nodes.get(h.node)) else {
+                    return out;
+                };
+                let (_, k) = h.resultants(&h.offsets(node));
+                if k.iter().all(|v| *v == 0.0) {
+                    return out;
+                }
+                let jac = h.jacobian(node);
+                let a: [[f64; 6]; 6] = std::array::from_fn(|i| {
+                    std::array::from_fn(|j| (0..6).map(|r| jac[r][i] * k[r] * jac[r][j]).sum())
+                });
+                let mut inv = [[0.0; 6]; 6];
+                for col in 0..6 {
+                    let mut e = vec![0.0; n];
+                    e[h.node * DOF + col] = 1.0;
+                    f.solve(&mut e);
+                    for (row, line) in inv.iter_mut().enumerate() {
+                        line[col] = e[h.node * DOF + row];
+                    }
+                }
+                let mul = |x: &[[f64; 6]; 6], y: &[[f64; 6]; 6]| -> [[f64; 6]; 6] {
+                    std::array::from_fn(|i| {
+                        std::array::from_fn(|j| (0..6).map(|m| x[i][m] * y[m][j]).sum())
+                    })
+                };
+                let asa = mul(&mul(&a, &inv), &a);
+                for i in 0..6 {
+                    for j in 0..6 {
+                        out[i][j] = a[i][j] - 0.5 * (asa[i][j] + asa[j][i]);
+                    }
+                }
+                out
             })
             .collect()
     }

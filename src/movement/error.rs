@@ -92,6 +92,9 @@ pub enum MovementError {
     /// The case's sphere trees could not be built.
     #[error(transparent)]
     Trees(#[from] TreeBuildError),
+    /// Brackets or a wire cannot be placed as asked.
+    #[error("appliance: {0}")]
+    Appliance(String),
     /// A simulation of the named case could not be made.
     #[error("{case}: {source}")]
     InCase {

@@ -31,4 +31,6 @@ pub use report::{
     neighbour_pairs, pair_distances, run_case, tooth_travel,
 };
 pub use settings::{MovementModel, MovementSettings, Response};
-pub use sim::{Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome};
+pub use sim::{
+    ArchWire, Bonded, Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome, WireChoice,
+};

@@ -141,6 +141,11 @@ pub struct PdlBody {
     pub mean_spring: f64,
     /// Applied wrench about the centre (N, N·mm).
     pub applied: Vec6,
+    /// What an appliance whose force falls as the body moves makes of its motion:
+    /// `(I + rate·C·K)⁻¹` for the appliance's stiffness K, so that a step moves the body where
+    /// the appliance's force at the step's end would (backward Euler) and no stiff wire makes it
+    /// overshoot; None: no such appliance.
+    pub damping: Option<Mat6>,
 }
 
 impl PdlBody {
@@ -157,7 +162,11 @@ impl PdlBody {
             return [0.0; 6];
         }
         let scale = rate * (1.0 - threshold_kpa / p);
-        self.compliance.mul_vec(w).map(|v| v * scale)
+        let t = self.compliance.mul_vec(w).map(|v| v * scale);
+        match &self.damping {
+            Some(d) => d.mul_vec(&t),
+            None => t,
+        }
     }
 
     /// Velocity (per step) of world point `p` under twist `t`.

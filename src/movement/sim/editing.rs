@@ -157,6 +157,7 @@ impl Simulation {
             pdl: super::PdlState::default(),
             elapsed_days: 0.0,
             known: BTreeMap::new(),
+            wires: Vec::new(),
         };
         if settings.model == MovementModel::Pdl {
             for t in &mut sim.teeth {
@@ -349,6 +350,19 @@ impl Simulation {
         next.total_impacts = self.total_impacts;
         next.total_energy_lost_uj = self.total_energy_lost_uj;
         next.elapsed_days = self.elapsed_days;
+        // The wires are laid again through the brackets left (as a wire is engaged afresh
+        // after an extraction).
+        for w in &self.wires {
+            let teeth: Vec<Fdi> = w
+                .brackets
+                .iter()
+                .map(|b| b.fdi)
+                .filter(|f| next.index_of(*f).is_some())
+                .collect();
+            if teeth.len() >= 3 {
+                next.bond(w.arch, w.choice, &teeth)?;
+            }
+        }
         Ok(next)
     }
 }

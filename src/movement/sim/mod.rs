@@ -55,12 +55,14 @@ use std::{
 use glam::Vec3;
 use serde::Serialize;
 
+mod archwire;
 mod blocking;
 mod editing;
 mod impulse;
 mod pdl_step;
 mod proposal;
 
+pub use archwire::{ArchWire, Bonded, STEP_ITERATIONS, STEP_TOLERANCE_N, WireChoice};
 pub use pdl_step::{MAX_SWEEPS, PUSH_BIAS_MM, PdlState, SOLVE_TOLERANCE_MM};
 
 use super::{
@@ -256,6 +258,8 @@ pub struct Simulation {
     /// start (exact method), by tooth pair: the next step's queries start from them.
     /// (Each holds the geometries it was found for; a query ignores one of other meshes.)
     known: BTreeMap<(usize, usize), EndOverlap>,
+    /// Archwires with their brackets, at most one per arch.
+    pub wires: Vec<ArchWire>,
 }
 
 fn row(arch: Arch) -> usize {

@@ -180,8 +180,10 @@ impl Simulation {
     }
 
     /// The body of `members` (one tooth, or a group led by the first) under `force` at the
-    /// bracket(s) and `torque`.
+    /// bracket(s) and `torque`, and the archwire's loads on the members that carry brackets
+    /// (which replace the old wire model's blocking for the whole body).
     fn unit(&self, members: Vec<usize>, force: Vec3, torque: Vec3) -> Option<Unit> {
+        let wire: Vec<_> = members.iter().flat_map(|&i| self.wire_loads(i)).collect();
         let lead = members[0];
         let s = &self.settings.pdl;
         let mut parts = Vec::new();
@@ -213,7 +215,7 @@ impl Simulation {
             .sum::<Vec3>()
             / n as f32;
         let axis = t.pose.transform_vector(t.shape.geometry.frame.long_axis);
-        if s.wire_holds_brackets {
+        if s.wire_holds_brackets && wire.is_empty() {
             let frame = self.arch_frame(lead);
             let b = bracket.as_dvec3() - centre;
             let across: Vec<Vec6> = held_directions([frame.buccal, frame.up], force)
@@ -223,20 +225,32 @@ impl Simulation {
             compliance = blocked(&compliance, &across, 1.0);
         }
         let mut couple = torque.as_dvec3();
-        match (t.wire, t.mf) {
-            (WireModel::Rectangular, Some(mf)) => {
+        let model = if wire.is_empty() { Some(t.wire) } else { None };
+        match (model, t.mf) {
+            (Some(WireModel::Rectangular), Some(mf)) => {
                 couple -= (axis.cross(force) * mf).as_dvec3();
             }
-            (WireModel::Rectangular, None) => {
+            (Some(WireModel::Rectangular), None) => {
                 let turns: Vec<Vec6> = held_directions([Vec3::X, Vec3::Y, Vec3::Z], torque)
                     .into_iter()
                     .map(|n| vec6(DVec3::ZERO, n))
                     .collect();
                 compliance = blocked(&compliance, &turns, s.wire_engagement as f64);
             }
-            (WireModel::Round, _) => {}
+            (Some(WireModel::Round), _) | (None, _) => {}
         }
-        let applied = wrench(force.as_dvec3(), bracket.as_dvec3(), couple, centre);
+        let mut applied = wrench(force.as_dvec3(), bracket.as_dvec3(), couple, centre);
+        let mut damping = None;
+        if !wire.is_empty() {
+            let (w, k) = super::archwire::about(&wire, centre);
+            for (a, b) in applied.iter_mut().zip(w) {
+                *a += b;
+            }
+            // Backward Euler against the wire's stiffness: (I + rate·C·K)⁻¹.
+            let rate = s.remodelling_per_day as f64 * s.step_days();
+            let m = crate::geometry::Mat6::identity().add_scaled(&compliance.mul(&k), rate);
+            damping = m.inverse();
+        }
         let area = parts.iter().map(|(_, _, p)| p.root_area_mm2).sum();
         Some(Unit {
             members,
@@ -246,6 +260,7 @@ impl Simulation {
                 area,
                 mean_spring: parts[0].2.mean_spring,
                 applied,
+                damping,
             },
         })
     }
@@ -255,7 +270,10 @@ impl Simulation {
         let n = self.teeth.len();
         // Only loaded teeth and teeth in contact can move: the others are not bodies this step.
         let loaded = |l: &crate::teeth::Load| l.force != Vec3::ZERO || l.torque != Vec3::ZERO;
-        let mut needed: Vec<bool> = self.teeth.iter().map(|t| loaded(&t.load)).collect();
+        self.solve_wires();
+        let mut needed: Vec<bool> = (0..n)
+            .map(|i| loaded(&self.teeth[i].load) || self.is_bonded(i))
+            .collect();
         for f in &self.pdl.touching {
             needed[f.a] = true;
             needed[f.b] = true;
@@ -275,9 +293,10 @@ impl Simulation {
                 wire: t.wire,
                 mf: t.mf,
             };
+            let bonded = self.is_bonded(i);
             let cached = self.pdl.cache[i]
                 .as_ref()
-                .filter(|(k, _)| *k == key)
+                .filter(|(k, _)| *k == key && !bonded)
                 .map(|(_, b)| b.clone());
             let body = match cached {
                 Some(b) => Some(b),

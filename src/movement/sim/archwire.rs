@@ -1,0 +1,322 @@
+//! Archwires in the simulation: brackets bonded on an arch's teeth, the wire through them
+//! brought to equilibrium at the teeth's poses every step, and what it does to each tooth.
+//!
+//! **Coupling.** Each step the wire is solved where the brackets stand (warm: its nodes and its
+//! tangent's factor carry over from the last step); each bonded tooth then receives its slot's
+//! reaction (force and moment) as an applied load at its bracket, in place of the old wire
+//! model's blocking. A stiff wire over a day's step would push a tooth past where the wire is
+//! passive and back again (explicit coupling is unstable once rate × ligament compliance × wire
+//! stiffness passes 2), so each bonded body also carries the wire's stiffness at its bracket
+//! (the slot's walls in series with the re-balanced wire, [`Rod::holder_stiffness`]) and moves
+//! by backward Euler: where the wire's force at the step's end balances the ligament's motion
+//! ([`crate::movement::pdl::PdlBody::damping`]). Teeth are coupled to each other through the wire
+//! only via its solve at the next step (the stiffness is each bracket's own block).
+//!
+//! **Guarantee.** With the wire converged, the forces on the brackets are the discrete rod's
+//! (see [`crate::appliance::rod`]); a tooth whose bracket is passive within its slot's play
+//! feels nothing from the wire and stops. A solve that does not converge keeps its best
+//! equilibrium and is reported in [`ArchWire::last`].
+
+use glam::{DMat3, DVec3};
+
+use super::Simulation;
+use crate::{
+    appliance::{
+        ArchForm, ArchSize, Bracket, Equilibrium, Holder, Prescription, Reaction, Rod, Settings,
+        Slot, ToothAxes, WireMaterial, WireSize, lay,
+    },
+    geometry::{Mat6, Vec6, vec6},
+    movement::MovementError,
+    teeth::{Arch, Fdi, Side, ToothKind},
+};
+
+/// Residual force (N) a step's wire solve stops at: a thousandth of the lightest force a wire
+/// moves a tooth with.
+pub const STEP_TOLERANCE_N: f64 = 1e-4;
+/// Most Newton iterations of a step's solve (engaging a wire may take more).
+pub const STEP_ITERATIONS: usize = 40;
+
+/// An archwire as a case or the panel chooses it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WireChoice {
+    /// Alloy.
+    pub material: WireMaterial,
+    /// Cross-section.
+    pub size: WireSize,
+    /// Preformed arch form.
+    pub form: ArchForm,
+    /// Brackets' slot.
+    pub slot: Slot,
+    /// Brackets' prescription.
+    pub prescription: Prescription,
+}
+
+impl Default for WireChoice {
+    fn default() -> Self {
+        Self {
+            material: WireMaterial::NiTi,
+            size: WireSize::Round(0.014),
+            form: ArchForm::Ovoid,
+            slot: Slot::S022,
+            prescription: Prescription::Mbt,
+        }
+    }
+}
+
+/// A bracket bonded on a tooth and the wire node it holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bonded {
+    /// The tooth (index in the simulation).
+    pub tooth: usize,
+    /// Its FDI number.
+    pub fdi: Fdi,
+    /// The bracket, in the tooth's frame.
+    pub bracket: Bracket,
+    /// The wire node its slot holds.
+    pub node: usize,
+}
+
+/// An arch's brackets and archwire.
+#[derive(Clone, Debug)]
+pub struct ArchWire {
+    /// The arch.
+    pub arch: Arch,
+    /// The wire chosen.
+    pub choice: WireChoice,
+    /// The wire as it stands.
+    pub rod: Rod,
+    /// The brackets, from the patient's right to left.
+    pub brackets: Vec<Bonded>,
+    /// What each bracket feels from the wire (world: force in N, moment in N·mm about its slot).
+    pub reactions: Vec<Reaction>,
+    /// Each bracket's stiffness against the wire (world, at its slot).
+    pub stiffness: Vec<[[f64; 6]; 6]>,
+    /// How the last solve ended.
+    pub last: Equilibrium,
+    /// Time of the last solve (ns).
+    pub solve_ns: u64,
+}
+
+impl ArchWire {
+    /// The reaction on the bracket of tooth `i`, if bonded.
+    pub fn reaction_of(&self, i: usize) -> Option<Reaction> {
+        let k = self.brackets.iter().position(|b| b.tooth == i)?;
+        self.reactions.get(k).copied()
+    }
+}
+
+impl Simulation {
+    /// Bonds brackets on `teeth` of `arch` (when empty, all its teeth but third molars, as
+    /// brackets and tubes are bonded from second molar to second molar) and engages `choice`'s wire
+    /// through them, replacing any wire the arch had; the wire's passive shape is its arch form
+    /// sized to the brackets.
+    ///
+    /// # Errors
+    /// [`MovementError::NotInCase`] for a listed tooth the simulation lacks or of the other arch;
+    /// [`MovementError::Appliance`] when fewer than three teeth carry brackets or a tooth has no
+    /// ligament (the PDL model is off).
+    pub fn bond(
+        &mut self,
+        arch: Arch,
+        choice: WireChoice,
+        teeth: &[Fdi],
+    ) -> Result<(), MovementError> {
+        for f in teeth {
+            if f.arch() != arch || self.index_of(*f).is_none() {
+                return Err(MovementError::NotInCase(*f));
+            }
+        }
+        self.debond(arch);
+        let mut chosen: Vec<usize> = (0..self.teeth.len())
+            .filter(|&i| {
+                let f = self.teeth[i].fdi;
+                let listed = if teeth.is_empty() {
+                    f.kind() != ToothKind::ThirdMolar
+                } else {
+                    teeth.contains(&f)
+                };
+                f.arch() == arch && listed
+            })
+            .collect();
+        chosen.sort_by_key(|&i| self.teeth[i].fdi.arch_index());
+        if chosen.len() < 3 {
+            return Err(MovementError::Appliance(format!(
+                "an archwire needs brackets on at least three teeth of the {arch:?} arch, got {}",
+                chosen.len()
+            )));
+        }
+        let mut brackets = Vec::new();
+        let mut points = Vec::new();
+        for &i in &chosen {
+            let t = &self.teeth[i];
+            let Some(p) = t.pdl.as_ref() else {
+                return Err(MovementError::Appliance(format!(
+                    "tooth {} has no ligament: brackets need the PDL movement model",
+                    t.fdi
+                )));
+            };
+            let frame = &t.shape.geometry.frame;
+            let mesial = (frame.mesiodistal * t.fdi.local_x_mesial_sign()).as_dvec3();
+            let right = t.fdi.side() == Side::Right;
+            let axes = ToothAxes {
+                buccal: frame.buccolingual.as_dvec3(),
+                along: if right { mesial } else { -mesial },
+                along_is_mesial: right,
+            };
+            let bracket = Bracket::place(
+                arch,
+                t.fdi.kind(),
+                p.bracket.as_dvec3(),
+                &axes,
+                choice.prescription,
+                choice.slot,
+            );
+            let (rotation, translation) = world(t);
+            points.push(translation + rotation * bracket.centre);
+            brackets.push(Bonded {
+                tooth: i,
+                fdi: t.fdi,
+                bracket,
+                node: 0,
+            });
+        }
+        let size = ArchSize::fit(&points).ok_or_else(|| {
+            MovementError::Appliance(format!("the {arch:?} arch's brackets span no arch form"))
+        })?;
+        let (left, right) = (
+            points.iter().max_by(|a, b| a.x.total_cmp(&b.x)),
+            points.iter().min_by(|a, b| a.x.total_cmp(&b.x)),
+        );
+        let z0 = match (left, right) {
+            (Some(l), Some(r)) => 0.5 * (l.z + r.z),
+            _ => 0.0,
+        };
+        let y = points.iter().map(|p| p.y).sum::<f64>() / points.len() as f64;
+        let laid = lay(choice.form, &size, y, z0, &points);
+        for (b, &node) in brackets.iter_mut().zip(&laid.held) {
+            b.node = node;
+        }
+        let rod = Rod::new(laid.nodes, choice.size, choice.material);
+        let n = brackets.len();
+        self.wires.push(ArchWire {
+            arch,
+            choice,
+            rod,
+            brackets,
+            reactions: vec![Reaction::default(); n],
+            stiffness: vec![[[0.0; 6]; 6]; n],
+            last: Equilibrium {
+                iterations: 0,
+                residual: 0.0,
+                converged: true,
+            },
+            solve_ns: 0,
+        });
+        let k = self.wires.len() - 1;
+        self.solve_wire(k, 200);
+        self.pdl.cache.clear();
+        Ok(())
+    }
+
+    /// Removes `arch`'s brackets and wire.
+    pub fn debond(&mut self, arch: Arch) {
+        self.wires.retain(|w| w.arch != arch);
+        self.pdl.cache.clear();
+    }
+
+    /// The holders of wire `k`'s brackets at the teeth's current poses.
+    fn holders(&self, k: usize) -> Vec<Holder> {
+        let w = &self.wires[k];
+        w.brackets
+            .iter()
+            .map(|b| {
+                let (rotation, translation) = world(&self.teeth[b.tooth]);
+                b.bracket
+                    .holder(b.node, rotation, translation, w.choice.size)
+            })
+            .collect()
+    }
+
+    /// Brings wire `k` to equilibrium at the teeth's poses and records its reactions and
+    /// stiffnesses.
+    fn solve_wire(&mut self, k: usize, iterations: usize) {
+        let holders = self.holders(k);
+        let clock = std::time::Instant::now();
+        let w = &mut self.wires[k];
+        let settings = Settings {
+            tolerance_n: STEP_TOLERANCE_N,
+            max_iterations: iterations,
+        };
+        w.last = w.rod.solve(&holders, &[], &settings);
+        w.reactions = w.rod.reactions(&holders);
+        w.stiffness = w.rod.holder_stiffness(&holders);
+        w.solve_ns = clock.elapsed().as_nanos() as u64;
+    }
+
+    /// Solves every wire at the teeth's current poses (each step, before the ligaments move).
+    pub(super) fn solve_wires(&mut self) {
+        for k in 0..self.wires.len() {
+            self.solve_wire(k, STEP_ITERATIONS);
+        }
+    }
+
+    /// The wire's loads on tooth `i`: per bracket bonded on it, the slot's centre (world), its
+    /// reaction and its stiffness.
+    pub(super) fn wire_loads(&self, i: usize) -> Vec<(DVec3, Reaction, Mat6)> {
+        let mut out = Vec::new();
+        for w in &self.wires {
+            for (k, b) in w.brackets.iter().enumerate() {
+                if b.tooth != i {
+                    continue;
+                }
+                let (rotation, translation) = world(&self.teeth[i]);
+                let at = translation + rotation * b.bracket.centre;
+                out.push((at, w.reactions[k], Mat6(w.stiffness[k])));
+            }
+        }
+        out
+    }
+
+    /// Whether tooth `i` carries a bracket.
+    pub fn is_bonded(&self, i: usize) -> bool {
+        self.wires
+            .iter()
+            .any(|w| w.brackets.iter().any(|b| b.tooth == i))
+    }
+}
+
+/// A tooth's pose as a double-precision rotation and translation.
+fn world(t: &super::SimTooth) -> (glam::DQuat, DVec3) {
+    (
+        t.pose.rotation.as_dquat().normalize(),
+        t.pose.translation.as_dvec3(),
+    )
+}
+
+/// The wrench about `centre` of the wire's loads, and their stiffness against the body's twist
+/// about `centre` (`Tᵀ·K·T`, T carrying the twist to each slot).
+pub(super) fn about(loads: &[(DVec3, Reaction, Mat6)], centre: DVec3) -> (Vec6, Mat6) {
+    let mut wrench = [0.0; 6];
+    let mut stiffness = Mat6::ZERO;
+    for (at, r, k) in loads {
+        let arm = *at - centre;
+        let w = vec6(r.force, r.moment + arm.cross(r.force));
+        for (a, b) in wrench.iter_mut().zip(w) {
+            *a += b;
+        }
+        // T = [[I, −[arm]×], [0, I]]: the slot's motion under the body's twist.
+        let mut t = Mat6::identity();
+        let skew = DMat3::from_cols(
+            DVec3::new(0.0, arm.z, -arm.y),
+            DVec3::new(-arm.z, 0.0, arm.x),
+            DVec3::new(arm.y, -arm.x, 0.0),
+        );
+        for c in 0..3 {
+            for r in 0..3 {
+                t.0[r][3 + c] = -skew.col(c)[r];
+            }
+        }
+        stiffness = stiffness.add_scaled(&t.transpose().mul(k).mul(&t), 1.0);
+    }
+    (wrench, stiffness)
+}
