@@ -371,6 +371,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
     let params = SolveParams {
         rate: 1.0,
         threshold_kpa: 0.0,
+        saturation_kpa: f64::INFINITY,
         tolerance: 1e-12,
         max_sweeps: 2_000,
     };

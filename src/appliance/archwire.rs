@@ -16,8 +16,8 @@
 //! with a node exactly at each bracket's nearest point on the form, and says which node each
 //! bracket holds.
 
+pub use crate::teeth::case::appliance::ArchForm;
 use glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 use super::rod::RodNode;
 
@@ -25,19 +25,6 @@ use super::rod::RodNode;
 pub const TAIL_MM: f64 = 3.0;
 /// Spacing of the wire's nodes (mm).
 pub const SPACING_MM: f64 = 1.0;
-
-/// A preformed arch form.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ArchForm {
-    /// Ovoid.
-    #[default]
-    Ovoid,
-    /// Tapered.
-    Tapered,
-    /// Square.
-    Square,
-}
 
 /// The size of an arch form: first molar to first molar width and the depth from there to the
 /// incisors (mm, in the occlusal plane, at the slots).
@@ -71,6 +58,15 @@ impl ArchSize {
 impl ArchForm {
     /// Every form, for pickers.
     pub const ALL: [Self; 3] = [Self::Ovoid, Self::Tapered, Self::Square];
+
+    /// Its name as case files write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ovoid => "ovoid",
+            Self::Tapered => "tapered",
+            Self::Square => "square",
+        }
+    }
 
     /// Canine width over molar width, and the canines' depth behind the incisors over the arch
     /// depth.

@@ -16,8 +16,8 @@
 //! Kusy's critical contact angle (S − h)/W for a bracket W wide ([`binding_angle_rad`]). Slots
 //! are taken at their nominal sizes (real slots measure up to about 10 % larger, which adds play).
 
+pub use crate::teeth::case::appliance::Slot;
 use glam::{DQuat, DVec3};
-use serde::{Deserialize, Serialize};
 
 use super::prescription::Prescription;
 use super::rod::Holder;
@@ -29,18 +29,6 @@ pub const BASE_MM: f64 = 0.8;
 /// Stiffness of a slot's walls against the wire (N/mm): steel brackets are far stiffer than any
 /// wire's bending over an interbracket span.
 pub const WALL_N_PER_MM: f64 = 2.0e3;
-
-/// A bracket slot size.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Slot {
-    /// 0.018" × 0.025".
-    #[serde(rename = "0.018")]
-    S018,
-    /// 0.022" × 0.028".
-    #[default]
-    #[serde(rename = "0.022")]
-    S022,
-}
 
 impl Slot {
     /// Height (mm): what the wire's height fits into.

@@ -18,24 +18,9 @@
 //! unloads at about 1.0–1.5 N at 2 mm, as measured across brands (Materials Research 2015);
 //! copper NiTi's plateaus are lower.
 
-use serde::{Deserialize, Serialize};
+pub use crate::teeth::case::appliance::WireMaterial;
 
 use super::section::WireSize;
-
-/// An archwire's alloy.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum WireMaterial {
-    /// Austenitic stainless steel.
-    #[default]
-    StainlessSteel,
-    /// β-titanium (TMA).
-    Tma,
-    /// Superelastic nickel–titanium.
-    NiTi,
-    /// Copper NiTi (thermally activated at mouth temperature): lower plateaus than NiTi.
-    CopperNiTi,
-}
 
 /// Where a NiTi element stands on its flag-shaped law, kept between solves.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

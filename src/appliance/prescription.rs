@@ -54,20 +54,9 @@
 //! (0°, and the bracket inverted: +7° upper, +6° lower) and an inverted upper lateral (−10°); the
 //! table holds the routine brackets.
 
-use serde::{Deserialize, Serialize};
+pub use crate::teeth::case::appliance::Prescription;
 
 use crate::teeth::{Arch, ToothKind};
-
-/// A straight-wire prescription.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Prescription {
-    /// McLaughlin, Bennett and Trevisi (1997).
-    #[default]
-    Mbt,
-    /// Roth (1976, 1987).
-    Roth,
-}
 
 /// What a prescription builds into one tooth's bracket or tube.
 #[derive(Clone, Copy, Debug, PartialEq)]

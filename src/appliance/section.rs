@@ -8,55 +8,14 @@
 //! exactly; the torsion constant is the sharp rectangle's (Saint-Venant series) less the same
 //! share as the polar moment loses.
 
-use serde::{Deserialize, Serialize};
+pub use crate::teeth::case::appliance::{SizeError, WireSize};
 
 /// Millimetres per inch.
 pub const MM_PER_INCH: f64 = 25.4;
 /// Share of a rectangular wire's area its bevelled corners take (Rucker & Kusy 2002: 7–8 %).
 pub const BEVEL_AREA_LOSS: f64 = 0.075;
 
-/// A wire's cross-section, sizes in inches as wires are sold.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum WireSize {
-    /// Round wire of this diameter (inches).
-    Round(f64),
-    /// Rectangular wire: its height across the slot (occluso-gingival, inches) and its width
-    /// into the slot (bucco-lingual, inches), e.g. `Rect(0.019, 0.025)`.
-    Rect(f64, f64),
-}
-
-/// Why a wire size is refused.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum SizeError {
-    /// A size that is not a positive finite number.
-    #[error("wire size {0} is not a positive number of inches")]
-    NotPositive(f64),
-    /// A size outside the range orthodontic wires come in.
-    #[error("wire size {0}\" is outside 0.010–0.030\"")]
-    OutOfRange(f64),
-}
-
 impl WireSize {
-    /// Checks every dimension is a wire's (0.010–0.030 inches).
-    ///
-    /// # Errors
-    /// [`SizeError`] naming the first bad dimension.
-    pub fn check(self) -> Result<Self, SizeError> {
-        let dims = match self {
-            Self::Round(d) => [d, d],
-            Self::Rect(h, w) => [h, w],
-        };
-        for d in dims {
-            if !(d.is_finite() && d > 0.0) {
-                return Err(SizeError::NotPositive(d));
-            }
-            if !(0.010..=0.030).contains(&d) {
-                return Err(SizeError::OutOfRange(d));
-            }
-        }
-        Ok(self)
-    }
-
     /// As clinicians write it: `0.016"` or `0.019×0.025"`.
     pub fn label(self) -> String {
         match self {

@@ -6,7 +6,9 @@ use anyhow::Result;
 use clap::Args;
 use orthosim::{
     collision::Method,
-    movement::{MovementModel, MovementSettings, Response, SimulationReport, run_case},
+    movement::{
+        MovementModel, MovementSettings, Response, RunLimit, SimulationReport, run_case_for,
+    },
 };
 
 use super::{
@@ -34,6 +36,10 @@ pub struct SimulateArgs {
     /// Most steps to run.
     #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     pub max_steps: u64,
+    /// Most clinical days to run (PDL model; a step is `step_hours` of the settings, a day by
+    /// default), as an alternative to `--max-steps`.
+    #[arg(long, value_parser = days)]
+    pub days: Option<f64>,
     #[command(flatten)]
     pub trees: TreeArgs,
     /// Movement settings (a RON `MovementSettings`; missing fields keep their defaults);
@@ -43,6 +49,16 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// A number of clinical days: finite, above zero, at most a century.
+fn days(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v > 0.0 && v <= 36_500.0 {
+        Ok(v)
+    } else {
+        Err(format!("days must be in (0, 36500], got {s}"))
+    }
 }
 
 /// Runs the case and prints the report.
@@ -59,14 +75,27 @@ pub fn run(args: SimulateArgs) -> Result<()> {
     if progress {
         eprint!("building trees…");
     }
-    let max_steps = args.max_steps;
-    let run = run_case(
+    if args.days.is_some() && settings.model != MovementModel::Pdl {
+        anyhow::bail!("--days needs the PDL movement model (clinical time); use --max-steps");
+    }
+    let max_steps = match args.days {
+        // Enough steps for the days asked, whatever a step's length.
+        Some(d) => {
+            ((d * 24.0 / settings.pdl.step_hours as f64).ceil() as u64 + 1).max(args.max_steps)
+        }
+        None => args.max_steps,
+    };
+    let limit = RunLimit {
+        max_steps,
+        max_days: args.days,
+    };
+    let run = run_case_for(
         &args.case,
         args.algorithm,
         settings,
         args.trees.settings(),
         args.trees.cache().as_ref(),
-        max_steps,
+        limit,
         |step| {
             if progress && (step % 50 == 0 || step == max_steps) {
                 eprint!("\rsimulating: step {step}/{max_steps}          ");
@@ -113,6 +142,45 @@ fn print_table(r: &SimulationReport) {
             format!("{}-{}", d.a, d.b),
             d.centre_distance_mm,
             d.surface_gap_mm
+        );
+    }
+    if let Some(a) = &r.appliance {
+        for (arch, wires) in &a.wires {
+            let seq: Vec<String> = wires
+                .iter()
+                .map(|w| {
+                    format!(
+                        "day {:.0}: {} {} {}",
+                        w.day,
+                        w.size,
+                        w.material,
+                        w.form.name()
+                    )
+                })
+                .collect();
+            println!("{arch} wire: {}", seq.join(", then "));
+        }
+        println!("{:>5} {:>24} {:>26}", "tooth", "force N", "moment N·mm");
+        for b in &a.brackets {
+            let v = |x: [f64; 3]| format!("{:7.3} {:7.3} {:7.3}", x[0], x[1], x[2]);
+            println!(
+                "{:>5} {:>24} {:>26}{}",
+                b.fdi.to_string(),
+                v(b.force_n),
+                v(b.moment_nmm),
+                if b.engaged { "" } else { "  (passive)" }
+            );
+        }
+        println!(
+            "wire solve {:.0} µs per step (median; most {:.0}), {:.2}× the collision step{}",
+            a.solve_us_per_step[0],
+            a.solve_us_per_step[1],
+            a.solve_over_collision,
+            if a.converged {
+                ""
+            } else {
+                "; some solves did not converge"
+            }
         );
     }
     println!(

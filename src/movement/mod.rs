@@ -27,8 +27,9 @@ pub use plugin::{
     SetMomentToForce, SetWire, SimulationState, ToothImpact,
 };
 pub use report::{
-    CaseRun, MOVED_MM, PairDistance, SimulationReport, ToothTravel, max_penetration,
-    neighbour_pairs, pair_distances, run_case, tooth_travel,
+    ApplianceReport, BracketReport, CaseRun, MOVED_MM, PairDistance, RunLimit, SimulationReport,
+    ToothTravel, WireReport, max_penetration, neighbour_pairs, pair_distances, run_case,
+    run_case_for, tooth_travel,
 };
 pub use settings::{MovementModel, MovementSettings, Response};
 pub use sim::{

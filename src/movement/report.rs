@@ -10,8 +10,13 @@ use std::{collections::BTreeMap, time::Instant};
 
 use serde::Serialize;
 
-use super::{MovementError, settings::MovementSettings, sim::Simulation};
+use super::{
+    MovementError,
+    settings::MovementSettings,
+    sim::{Simulation, WireChoice},
+};
 use crate::{
+    appliance::ArchForm,
     collision::{Method, shape::collision_shapes},
     geometry::mesh_separation,
     sphere_tree::{TreeCache, TreeSettings},
@@ -108,6 +113,75 @@ pub struct SimulationReport {
     pub energy_lost_uj: f64,
     /// Crown-tip and apex travel and rotation per tooth.
     pub teeth: Vec<ToothTravel>,
+    /// Brackets and archwires, when the case bonds any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub appliance: Option<ApplianceReport>,
+}
+
+/// A wire as the report names it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct WireReport {
+    /// Alloy.
+    pub material: &'static str,
+    /// Section as clinicians write it.
+    pub size: String,
+    /// Arch form.
+    pub form: ArchForm,
+    /// Brackets' slot.
+    pub slot: &'static str,
+    /// Clinical day it was engaged.
+    pub day: f64,
+}
+
+impl WireReport {
+    fn of(day: f64, c: &WireChoice) -> Self {
+        Self {
+            material: c.material.name(),
+            size: c.size.label(),
+            form: c.form,
+            slot: c.slot.label(),
+            day,
+        }
+    }
+}
+
+/// What the wire does to one bracket at the end of the run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BracketReport {
+    /// The tooth.
+    pub fdi: Fdi,
+    /// Force on the bracket (N, world).
+    pub force_n: [f64; 3],
+    /// Moment on the bracket about its slot (N·mm, world).
+    pub moment_nmm: [f64; 3],
+    /// True when the wire bears on the slot (outside its play).
+    pub engaged: bool,
+}
+
+/// The appliances at the end of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ApplianceReport {
+    /// The wire in place at the end (the lower arch's when both arches carry one).
+    pub wire: WireReport,
+    /// Each arch's wires in the order they were engaged.
+    pub wires: BTreeMap<&'static str, Vec<WireReport>>,
+    /// Every bracket, upper arch first, each from the patient's right.
+    pub brackets: Vec<BracketReport>,
+    /// Wire solves per step, all arches (µs: median and most), measured in this run.
+    pub solve_us_per_step: [f64; 2],
+    /// The median wire solve over the median collision step of this run.
+    pub solve_over_collision: f64,
+    /// Whether every wire solve of the run converged.
+    pub converged: bool,
+}
+
+/// How long a run may go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunLimit {
+    /// Most steps.
+    pub max_steps: u64,
+    /// Most clinical days (PDL model), if limited.
+    pub max_days: Option<f64>,
 }
 
 /// Adjacent present teeth along each arch, from the patient's right to left (indices).
@@ -181,6 +255,70 @@ pub fn max_penetration(sim: &Simulation) -> f32 {
     worst
 }
 
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn appliance_report(
+    sim: &Simulation,
+    collision_steps: Vec<f64>,
+    wire_steps: Vec<f64>,
+    converged: bool,
+) -> Option<ApplianceReport> {
+    let last = sim
+        .wires
+        .iter()
+        .find(|w| w.arch == Arch::Lower)
+        .or(sim.wires.first())?;
+    let wire = WireReport::of(last.history.last().map_or(0.0, |h| h.0), &last.choice);
+    let mut wires = BTreeMap::new();
+    let mut brackets = Vec::new();
+    for arch in [Arch::Upper, Arch::Lower] {
+        let Some(w) = sim.wires.iter().find(|w| w.arch == arch) else {
+            continue;
+        };
+        let name = if arch == Arch::Upper {
+            "upper"
+        } else {
+            "lower"
+        };
+        wires.insert(
+            name,
+            w.history
+                .iter()
+                .map(|(d, c)| WireReport::of(*d, c))
+                .collect(),
+        );
+        for (b, r) in w.brackets.iter().zip(&w.reactions) {
+            brackets.push(BracketReport {
+                fdi: b.fdi,
+                force_n: r.force.to_array(),
+                moment_nmm: r.moment.to_array(),
+                engaged: r.force.length() > 1e-9 || r.moment.length() > 1e-9,
+            });
+        }
+    }
+    let most = wire_steps.iter().copied().fold(0.0, f64::max);
+    let solve = median(wire_steps);
+    let collision = median(collision_steps);
+    Some(ApplianceReport {
+        wire,
+        wires,
+        brackets,
+        solve_us_per_step: [solve, most],
+        solve_over_collision: if collision > 0.0 {
+            solve / collision
+        } else {
+            0.0
+        },
+        converged,
+    })
+}
+
 /// A finished run: the report and the simulation in its final state.
 pub struct CaseRun {
     /// The measures.
@@ -202,8 +340,30 @@ pub fn run_case(
     trees: TreeSettings,
     cache: Option<&TreeCache>,
     max_steps: u64,
+    progress: impl FnMut(u64),
+) -> Result<CaseRun, MovementError> {
+    let limit = RunLimit {
+        max_steps,
+        max_days: None,
+    };
+    run_case_for(case, method, settings, trees, cache, limit, progress)
+}
+
+/// [`run_case`] to a [`RunLimit`]: the run also stops when its clinical time reaches
+/// `max_days`, and does not count as at rest while a wire change is still to come.
+///
+/// # Errors
+/// As [`run_case`].
+pub fn run_case_for(
+    case: &str,
+    method: Method,
+    settings: MovementSettings,
+    trees: TreeSettings,
+    cache: Option<&TreeCache>,
+    limit: RunLimit,
     mut progress: impl FnMut(u64),
 ) -> Result<CaseRun, MovementError> {
+    let max_steps = limit.max_steps;
     let loaded = Case::resolve(case)?;
     let name = loaded.case.name.clone();
     let d = Dentition::build(loaded)?;
@@ -216,10 +376,18 @@ pub fn run_case(
     let start = Instant::now();
     let mut collision_ns = 0u64;
     let mut at_rest = false;
-    while sim.steps < max_steps {
+    let mut collision_steps = Vec::new();
+    let mut wire_steps = Vec::new();
+    let mut converged = true;
+    while sim.steps < max_steps && limit.max_days.is_none_or(|d| sim.elapsed_days < d - 1e-9) {
         let out = sim.step();
         collision_ns += out.collision_ns;
-        at_rest = out.at_rest;
+        collision_steps.push(out.collision_ns as f64 / 1e3);
+        at_rest = out.at_rest && sim.wires.iter().all(|w| w.sequence.is_empty());
+        if !sim.wires.is_empty() {
+            wire_steps.push(sim.wires.iter().map(|w| w.solve_ns).sum::<u64>() as f64 / 1e3);
+            converged &= sim.wires.iter().all(|w| w.last.converged);
+        }
         progress(sim.steps);
         if at_rest {
             break;
@@ -260,6 +428,7 @@ pub fn run_case(
         impacts: sim.total_impacts,
         energy_lost_uj: sim.total_energy_lost_uj,
         teeth: tooth_travel(&sim),
+        appliance: appliance_report(&sim, collision_steps, wire_steps, converged),
     };
     Ok(CaseRun {
         report,

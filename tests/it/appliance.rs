@@ -114,3 +114,58 @@ fn a_niti_wire_brings_a_displaced_incisor_back_and_then_stops() {
         );
     }
 }
+
+#[test]
+fn the_crowded_case_aligns_under_its_first_wire_without_penetration() {
+    let loaded = Case::resolve("crowded").unwrap();
+    let d = Dentition::build(loaded).unwrap();
+    let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
+    let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+    // The case bonds the lower arch, second molar to second molar, with its wire sequence.
+    assert_eq!(sim.wires.len(), 1);
+    let w = &sim.wires[0];
+    assert_eq!(
+        (w.arch, w.brackets.len(), w.sequence.len()),
+        (Arch::Lower, 14, 2)
+    );
+    let energy0 = w.rod.energy();
+    let worst_force = |sim: &Simulation| {
+        sim.wires[0]
+            .reactions
+            .iter()
+            .map(|r| r.force.length())
+            .fold(0.0, f64::max)
+    };
+    let force0 = worst_force(&sim);
+    assert!(force0 > 0.5, "the crowding activates the wire: {force0} N");
+    let mut converged = true;
+    while sim.elapsed_days < 59.5 {
+        sim.step();
+        converged &= sim.wires[0].last.converged;
+    }
+    assert!(converged, "every wire solve converged");
+    let energy = sim.wires[0].rod.energy();
+    assert!(
+        energy < 0.2 * energy0,
+        "wire energy {energy} from {energy0}"
+    );
+    assert!(
+        worst_force(&sim) < 0.5 * force0,
+        "{} from {force0}",
+        worst_force(&sim)
+    );
+    assert!(deepest_overlap(&sim) < 0.05, "{}", deepest_overlap(&sim));
+    for t in &sim.teeth {
+        assert!(
+            t.displacement_mm() < 4.0,
+            "{} moved {} mm",
+            t.fdi,
+            t.displacement_mm()
+        );
+    }
+    // On day 60 the next wire goes in.
+    sim.step();
+    let w = &sim.wires[0];
+    assert_eq!(w.history.len(), 2);
+    assert_eq!(w.choice.size, orthosim::appliance::WireSize::Round(0.018));
+}

@@ -155,13 +155,15 @@ impl PdlBody {
     }
 
     /// The twist per step (mm, rad about the centre) under wrench `w`: `rate` × the elastic
-    /// twist, shrunk so that the pressure drops by the threshold (zero below it).
-    pub fn twist(&self, w: &Vec6, rate: f64, threshold_kpa: f64) -> Vec6 {
+    /// twist, shrunk so that the pressure drops by the threshold (zero below it) and no faster
+    /// than at `saturation_kpa`.
+    pub fn twist(&self, w: &Vec6, rate: f64, threshold_kpa: f64, saturation_kpa: f64) -> Vec6 {
         let p = self.pressure_kpa(w);
         if p.is_nan() || p <= threshold_kpa {
             return [0.0; 6];
         }
-        let scale = rate * (1.0 - threshold_kpa / p);
+        let drive = (p - threshold_kpa).min((saturation_kpa - threshold_kpa).max(0.0));
+        let scale = rate * drive / p;
         let t = self.compliance.mul_vec(w).map(|v| v * scale);
         match &self.damping {
             Some(d) => d.mul_vec(&t),

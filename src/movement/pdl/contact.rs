@@ -53,6 +53,8 @@ pub struct SolveParams {
     pub rate: f64,
     /// Ligament pressure threshold (kPa).
     pub threshold_kpa: f64,
+    /// Pressure past which movement is no faster (kPa; infinite: none).
+    pub saturation_kpa: f64,
     /// Convergence tolerance on relative velocities (mm per step).
     pub tolerance: f64,
     /// Most sweeps.
@@ -98,7 +100,7 @@ pub fn solve_contacts(
     let mut twists: Vec<Vec6> = bodies
         .iter()
         .zip(&wrenches)
-        .map(|(b, w)| b.twist(w, p.rate, p.threshold_kpa))
+        .map(|(b, w)| b.twist(w, p.rate, p.threshold_kpa, p.saturation_kpa))
         .collect();
     let normal_velocity = |twists: &[Vec6], c: &ContactRow| {
         let va = bodies[c.a].point_velocity(&twists[c.a], c.point);
@@ -125,7 +127,8 @@ pub fn solve_contacts(
             axpy(&mut wrenches[c.a], -delta, ja);
             axpy(&mut wrenches[c.b], delta, jb);
             for i in [c.a, c.b] {
-                twists[i] = bodies[i].twist(&wrenches[i], p.rate, p.threshold_kpa);
+                twists[i] =
+                    bodies[i].twist(&wrenches[i], p.rate, p.threshold_kpa, p.saturation_kpa);
             }
         }
         if largest <= p.tolerance {
@@ -180,6 +183,7 @@ mod tests {
         SolveParams {
             rate: 1.0,
             threshold_kpa,
+            saturation_kpa: f64::INFINITY,
             tolerance: 1e-12,
             max_sweeps: 10_000,
         }

@@ -75,6 +75,11 @@ pub struct PdlSettings {
     /// Bone remodelling rate β: the tooth moves by β × its initial (elastic) displacement per
     /// day, above the threshold (1/day).
     pub remodelling_per_day: f32,
+    /// Mean ligament pressure above which a heavier load moves the tooth no faster (kPa): past
+    /// an optimal force the rate of movement levels off (hyalinised ligament; Quinn & Yoshikawa,
+    /// AJO 1985;88:252–60). The default, 10 kPa, is about 2 N on a canine, above every
+    /// optimal force.
+    pub saturation_kpa: f32,
     /// Clinical time per simulation step (hours).
     pub step_hours: f32,
 }
@@ -93,6 +98,7 @@ impl Default for PdlSettings {
             wire_holds_brackets: true,
             threshold_kpa: 2.0,
             remodelling_per_day: 18.0,
+            saturation_kpa: 10.0,
             step_hours: 24.0,
         }
     }
@@ -119,7 +125,7 @@ impl PdlSettings {
     }
 
     /// Each parameter with its accepted range (name as in the settings file, value, min, max).
-    pub fn ranges(&self) -> [(&'static str, f32, f32, f32); 14] {
+    pub fn ranges(&self) -> [(&'static str, f32, f32, f32); 15] {
         let c = &self.crest_mm;
         [
             ("youngs_modulus_mpa", self.youngs_modulus_mpa, 1e-4, 100.0),
@@ -140,6 +146,7 @@ impl PdlSettings {
             ("wire_engagement", self.wire_engagement, 0.0, 1.0),
             ("threshold_kpa", self.threshold_kpa, 0.0, 1e3),
             ("remodelling_per_day", self.remodelling_per_day, 0.0, 1e3),
+            ("saturation_kpa", self.saturation_kpa, 0.0, 1e4),
             ("step_hours", self.step_hours, 1e-3, 24.0 * 30.0),
         ]
     }

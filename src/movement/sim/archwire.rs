@@ -27,14 +27,17 @@ use crate::{
     },
     geometry::{Mat6, Vec6, vec6},
     movement::MovementError,
-    teeth::{Arch, Fdi, Side, ToothKind},
+    teeth::{Arch, Fdi, Side, ToothKind, case::appliance::CaseAppliance},
 };
 
 /// Residual force (N) a step's wire solve stops at: a thousandth of the lightest force a wire
 /// moves a tooth with.
 pub const STEP_TOLERANCE_N: f64 = 1e-4;
-/// Most Newton iterations of a step's solve (engaging a wire may take more).
+/// Most Newton iterations of a step's solve, before it tries again with
+/// [`ENGAGE_ITERATIONS`].
 pub const STEP_ITERATIONS: usize = 40;
+/// Most Newton iterations when a wire is engaged, or a step's solve needs more.
+pub const ENGAGE_ITERATIONS: usize = 200;
 
 /// An archwire as a case or the panel chooses it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,6 +96,12 @@ pub struct ArchWire {
     pub stiffness: Vec<[[f64; 6]; 6]>,
     /// How the last solve ended.
     pub last: Equilibrium,
+    /// The arch form's size and place, kept for the wires that follow.
+    pub form: (ArchSize, f64, f64),
+    /// Wires still to come: the clinical day each is engaged, and the wire.
+    pub sequence: Vec<(f64, WireChoice)>,
+    /// The wires engaged so far: the day each was, and the wire.
+    pub history: Vec<(f64, WireChoice)>,
     /// Time of the last solve (ns).
     pub solve_ns: u64,
 }
@@ -112,9 +121,9 @@ impl Simulation {
     /// sized to the brackets.
     ///
     /// # Errors
-    /// [`MovementError::NotInCase`] for a listed tooth the simulation lacks or of the other arch;
+    /// [`MovementError::NotInCase`] for a listed tooth the simulation lacks;
     /// [`MovementError::Appliance`] when fewer than three teeth carry brackets or a tooth has no
-    /// ligament (the PDL model is off).
+    /// ligament (the PDL model is off), or a listed tooth of the other arch.
     pub fn bond(
         &mut self,
         arch: Arch,
@@ -122,7 +131,12 @@ impl Simulation {
         teeth: &[Fdi],
     ) -> Result<(), MovementError> {
         for f in teeth {
-            if f.arch() != arch || self.index_of(*f).is_none() {
+            if f.arch() != arch {
+                return Err(MovementError::Appliance(format!(
+                    "tooth {f} is not in the {arch:?} arch its wire is bonded on"
+                )));
+            }
+            if self.index_of(*f).is_none() {
                 return Err(MovementError::NotInCase(*f));
             }
         }
@@ -198,6 +212,7 @@ impl Simulation {
         }
         let rod = Rod::new(laid.nodes, choice.size, choice.material);
         let n = brackets.len();
+        let day = self.elapsed_days;
         self.wires.push(ArchWire {
             arch,
             choice,
@@ -210,12 +225,95 @@ impl Simulation {
                 residual: 0.0,
                 converged: true,
             },
+            form: (size, y, z0),
+            sequence: Vec::new(),
+            history: vec![(day, choice)],
             solve_ns: 0,
         });
         let k = self.wires.len() - 1;
-        self.solve_wire(k, 200);
+        self.solve_wire(k, ENGAGE_ITERATIONS);
         self.pdl.cache.clear();
         Ok(())
+    }
+
+    /// Bonds what a case file asks for: each arch's wire through its brackets, with its wire
+    /// sequence to follow.
+    ///
+    /// # Errors
+    /// As [`Simulation::bond`].
+    pub fn bond_case(&mut self, spec: &CaseAppliance) -> Result<(), MovementError> {
+        for (arch, wire) in [(Arch::Upper, &spec.upper), (Arch::Lower, &spec.lower)] {
+            let Some(w) = wire else {
+                continue;
+            };
+            let choice = WireChoice {
+                material: w.material,
+                size: w.size,
+                form: w.form,
+                slot: w.slot,
+                prescription: w.prescription,
+            };
+            let teeth: Vec<Fdi> = w
+                .bonded
+                .0
+                .iter()
+                .copied()
+                .filter(|f| self.index_of(*f).is_some())
+                .collect();
+            if !w.bonded.0.is_empty() && teeth.is_empty() {
+                return Err(MovementError::Appliance(format!(
+                    "none of the {arch:?} arch's bonded teeth is in the simulation"
+                )));
+            }
+            self.bond(arch, choice, &teeth)?;
+            let mut sequence: Vec<(f64, WireChoice)> = w
+                .sequence
+                .iter()
+                .map(|c| {
+                    (
+                        c.day.0 as f64,
+                        WireChoice {
+                            material: c.material,
+                            size: c.size,
+                            form: c.form.unwrap_or(w.form),
+                            ..choice
+                        },
+                    )
+                })
+                .collect();
+            sequence.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some(last) = self.wires.last_mut() {
+                last.sequence = sequence;
+            }
+        }
+        Ok(())
+    }
+
+    /// Takes wire `k` out and engages `choice` through the same brackets, laid on the same arch
+    /// form size (the patient's), at the teeth's current poses.
+    pub fn change_wire(&mut self, k: usize, choice: WireChoice) {
+        let Some(w) = self.wires.get(k) else {
+            return;
+        };
+        let (size, y, z0) = w.form;
+        let points: Vec<DVec3> = w
+            .brackets
+            .iter()
+            .map(|b| {
+                let (rotation, translation) = world(&self.teeth[b.tooth]);
+                translation + rotation * b.bracket.centre
+            })
+            .collect();
+        let laid = lay(choice.form, &size, y, z0, &points);
+        let day = self.elapsed_days;
+        let w = &mut self.wires[k];
+        for (b, &node) in w.brackets.iter_mut().zip(&laid.held) {
+            b.node = node;
+        }
+        w.rod = Rod::new(laid.nodes, choice.size, choice.material);
+        w.choice = choice;
+        w.history.push((day, choice));
+        self.solve_wire(k, ENGAGE_ITERATIONS);
     }
 
     /// Removes `arch`'s brackets and wire.
@@ -247,16 +345,43 @@ impl Simulation {
             tolerance_n: STEP_TOLERANCE_N,
             max_iterations: iterations,
         };
+        let before = w.rod.clone();
         w.last = w.rod.solve(&holders, &[], &settings);
-        w.reactions = w.rod.reactions(&holders);
-        w.stiffness = w.rod.holder_stiffness(&holders);
+        if !w.last.converged && iterations < ENGAGE_ITERATIONS {
+            w.last = w.rod.solve(
+                &holders,
+                &[],
+                &Settings {
+                    max_iterations: ENGAGE_ITERATIONS,
+                    ..settings
+                },
+            );
+        }
+        if w.last.converged || before.nodes.is_empty() {
+            w.reactions = w.rod.reactions(&holders);
+            w.stiffness = w.rod.holder_stiffness(&holders);
+        } else {
+            // No equilibrium found: the wire stays as it was and the brackets keep the last
+            // step's loads (never forces from a wire out of balance).
+            w.rod = before;
+        }
         w.solve_ns = clock.elapsed().as_nanos() as u64;
     }
 
     /// Solves every wire at the teeth's current poses (each step, before the ligaments move).
     pub(super) fn solve_wires(&mut self) {
         for k in 0..self.wires.len() {
-            self.solve_wire(k, STEP_ITERATIONS);
+            let due = self.wires[k]
+                .sequence
+                .first()
+                .filter(|(day, _)| *day <= self.elapsed_days + 1e-9)
+                .map(|(_, c)| *c);
+            if let Some(choice) = due {
+                self.wires[k].sequence.remove(0);
+                self.change_wire(k, choice);
+            } else {
+                self.solve_wire(k, STEP_ITERATIONS);
+            }
         }
     }
 

@@ -49,7 +49,11 @@ impl Simulation {
         method: Method,
         settings: MovementSettings,
     ) -> Result<Self, MovementError> {
-        Self::with_ligaments(d, shapes, method, settings, &[])
+        let mut sim = Self::with_ligaments(d, shapes, method, settings, &[])?;
+        if settings.model == MovementModel::Pdl {
+            sim.bond_case(&d.case.case.appliance)?;
+        }
+        Ok(sim)
     }
 
     /// [`Simulation::new`], taking the ligaments of `known` teeth (same settings) instead of

@@ -28,6 +28,12 @@ use crate::{
 
 /// Opening speed asked of touching teeth that move together (mm per step).
 pub const PUSH_BIAS_MM: f64 = 1e-5;
+/// How many times its own stiffness a bonded tooth's motion is damped by: the wire couples each
+/// bracket to its neighbours, and a bracket's stiffness matrix over the arch (a continuous beam's,
+/// rows like 1, −4, 6, −4, 1) has eigenvalues up to about 2.7 times its diagonal; damping by
+/// three times the diagonal keeps every tooth's step from overshooting whatever its neighbours
+/// do at once, at the price of a slower approach under very stiff wires.
+pub const WIRE_COUPLING: f64 = 3.0;
 /// Convergence tolerance of the contact solve (mm per step).
 pub const SOLVE_TOLERANCE_MM: f64 = 1e-9;
 /// Most sweeps of the contact solve.
@@ -246,9 +252,11 @@ impl Simulation {
             for (a, b) in applied.iter_mut().zip(w) {
                 *a += b;
             }
-            // Backward Euler against the wire's stiffness: (I + rate·C·K)⁻¹.
+            // Backward Euler against the wire's stiffness: (I + rate·C·K)⁻¹, K taken
+            // [`WIRE_COUPLING`] times over for the neighbours pulled along through the wire.
             let rate = s.remodelling_per_day as f64 * s.step_days();
-            let m = crate::geometry::Mat6::identity().add_scaled(&compliance.mul(&k), rate);
+            let m = crate::geometry::Mat6::identity()
+                .add_scaled(&compliance.mul(&k), rate * WIRE_COUPLING);
             damping = m.inverse();
         }
         let area = parts.iter().map(|(_, _, p)| p.root_area_mm2).sum();
@@ -348,6 +356,7 @@ impl Simulation {
         let params = SolveParams {
             rate: s.remodelling_per_day as f64 * s.step_days(),
             threshold_kpa: s.threshold_kpa as f64,
+            saturation_kpa: s.saturation_kpa as f64,
             tolerance: SOLVE_TOLERANCE_MM,
             max_sweeps: MAX_SWEEPS,
         };

@@ -4,6 +4,7 @@
 //! unknown fields, unknown or duplicate teeth, non-finite numbers, negative sizes, loads on extracted
 //! or absent teeth, absurd load magnitudes. See the README for the schema.
 
+pub mod appliance;
 mod parts;
 mod values;
 
@@ -20,11 +21,12 @@ pub use values::{Finite, NonNegative, ToothList, ToothMap};
 use super::{fdi::Fdi, import::ImportError, shape::ToothResolution};
 
 /// The built-in cases: name and RON source (embedded in the binary).
-pub const BUILTIN_CASES: [(&str, &str); 4] = [
+pub const BUILTIN_CASES: [(&str, &str); 5] = [
     ("normal", include_str!("../../../assets/cases/normal.ron")),
     ("case1", include_str!("../../../assets/cases/case1.ron")),
     ("case2", include_str!("../../../assets/cases/case2.ron")),
     ("case3", include_str!("../../../assets/cases/case3.ron")),
+    ("crowded", include_str!("../../../assets/cases/crowded.ron")),
 ];
 
 /// Longest case name (characters): the name becomes a file name when a case is exported.
@@ -130,6 +132,9 @@ pub struct Case {
     /// Archwires.
     #[serde(default)]
     pub wire: CaseWires,
+    /// Brackets and archwires per arch (the PDL movement model's appliances).
+    #[serde(default, skip_serializing_if = "appliance::CaseAppliance::is_empty")]
+    pub appliance: appliance::CaseAppliance,
     /// Movement constraints.
     #[serde(default)]
     pub constraints: Vec<CaseConstraint>,
