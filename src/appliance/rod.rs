@@ -20,23 +20,29 @@
 //! elements shorten (one-point strain sampling: a cantilever's tip deflection within 1 % at 20
 //! elements; tests check cantilever, three-point bending and torsion). A wire in its passive
 //! shape, held where it lies, carries no force at all. The strains' derivatives are exact (the
-//! rotation group's left Jacobian); the tangent is their Gauss–Newton part (it leaves out the
-//! stress resultants' geometric stiffness), so Newton converges linearly under large axial
-//! forces, which a line search on the energy keeps monotone.
+//! rotation group's left Jacobian). Far from equilibrium the tangent is their Gauss–Newton
+//! part (positive semi-definite, so every step goes downhill); once a full step is taken the
+//! geometric stiffness (the stress resultants on the strains' curvature, by differences of the
+//! exact derivatives) is added for Newton's quadratic convergence. A line search on the energy
+//! keeps every step monotone, and the tangent's factor is reused while it quarters the residual.
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DQuat, DVec3};
 
 use super::banded::{Banded, Factor};
+
+mod holder;
+mod strain;
+
 use super::material::{Transformation, WireMaterial};
 use super::section::WireSize;
+pub use holder::{EDGE_BLEND, Holder};
+use strain::{strains, strains_and_jacobian};
 
 /// Timoshenko's shear coefficient (round sections 0.9, rectangles 0.83; shear hardly matters in a
 /// slender wire).
 const SHEAR_FACTOR: f64 = 0.85;
 /// Forward-difference step for the geometric stiffness (mm and radians).
 const GEOMETRIC_STEP: f64 = 1e-6;
-/// Width over which a holder's wall comes into play (mm for offsets, radians for turns).
-pub const EDGE_BLEND: f64 = 1e-2;
 /// Degrees of freedom per node: three of position, three of rotation.
 const DOF: usize = 6;
 
@@ -79,193 +85,11 @@ impl RodNode {
     }
 }
 
-/// The rotation vector of `q` (shortest way round).
-fn log(q: DQuat) -> DVec3 {
-    let q = if q.w < 0.0 { -q } else { q };
-    q.to_scaled_axis()
-}
-
 #[derive(Clone, Debug)]
 struct Element {
     length: f64,
     rest: [f64; 6],
     state: Transformation,
-}
-
-/// An element's six strains between nodes `a` and `b` of rest length `length`: the chord in the
-/// mean frame over the length (stretch, two shears), then the relative rotation over the length
-/// (twist, two curvatures).
-fn strains(a: &RodNode, b: &RodNode, length: f64) -> [f64; 6] {
-    let omega = log(a.q.inverse() * b.q);
-    let mid = a.q * DQuat::from_scaled_axis(0.5 * omega);
-    let gamma = mid.inverse() * (b.x - a.x) / length;
-    let k = omega / length;
-    [gamma.x, gamma.y, gamma.z, k.x, k.y, k.z]
-}
-
-/// Puts the 3×3 block `m` into rows `row..row + 3`, columns `col..col + 3` of `jac`.
-fn put(jac: &mut [[f64; 12]; 6], row: usize, col: usize, m: DMat3) {
-    for c in 0..3 {
-        let v = m.col(c);
-        for r in 0..3 {
-            jac[row + r][col + c] = v[r];
-        }
-    }
-}
-
-/// [`strains`] and their derivatives by the two nodes' twelve increments (position of `a`, turn
-/// of `a`, position of `b`, turn of `b`; turns as world rotation vectors applied on the left).
-fn strains_and_jacobian(a: &RodNode, b: &RodNode, length: f64) -> ([f64; 6], [[f64; 12]; 6]) {
-    let omega = log(a.q.inverse() * b.q);
-    let mid = DMat3::from_quat(a.q * DQuat::from_scaled_axis(0.5 * omega));
-    let ra = DMat3::from_quat(a.q);
-    let chord = b.x - a.x;
-    let inv = 1.0 / length;
-    let mt = mid.transpose();
-    let gamma = mt * chord * inv;
-    let k = omega * inv;
-    // ω = log(Raᵀ·Rb): dω = Jl⁻¹(ω)·Raᵀ·(dθb − dθa).
-    let turn = jl_inv(omega) * ra.transpose();
-    // The mean frame qa·exp(ω/2) turns by δ = dθa + ½·Ra·Jl(ω/2)·dω.
-    let half = ra * jl(0.5 * omega) * turn * 0.5;
-    // γ = Mᵀ·chord/L: dγ = Mᵀ·(dxb − dxa)/L + Mᵀ·[chord]×·δ/L.
-    let by_turn = mt * skew(chord) * inv;
-    let mut jac = [[0.0; 12]; 6];
-    put(&mut jac, 0, 0, mt * -inv);
-    put(&mut jac, 0, 6, mt * inv);
-    put(&mut jac, 0, 3, by_turn * (DMat3::IDENTITY - half));
-    put(&mut jac, 0, 9, by_turn * half);
-    put(&mut jac, 3, 3, turn * -inv);
-    put(&mut jac, 3, 9, turn * inv);
-    ([gamma.x, gamma.y, gamma.z, k.x, k.y, k.z], jac)
-}
-
-/// The cross-product matrix of `v`: `skew(v) * w == v.cross(w)`.
-fn skew(v: DVec3) -> DMat3 {
-    DMat3::from_cols(
-        DVec3::new(0.0, v.z, -v.y),
-        DVec3::new(-v.z, 0.0, v.x),
-        DVec3::new(v.y, -v.x, 0.0),
-    )
-}
-
-/// The left Jacobian of the rotation group at `phi`: `exp(phi + d) ≈ exp(jl(phi)·d)·exp(phi)`.
-fn jl(phi: DVec3) -> DMat3 {
-    let t2 = phi.length_squared();
-    let s = skew(phi);
-    let (a, b) = if t2 < 1e-8 {
-        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
-    } else {
-        let t = t2.sqrt();
-        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
-    };
-    DMat3::IDENTITY + s * a + s * s * b
-}
-
-/// The inverse of [`jl`]: `log(exp(d)·exp(phi)) ≈ phi + jl_inv(phi)·d`.
-fn jl_inv(phi: DVec3) -> DMat3 {
-    let t2 = phi.length_squared();
-    let s = skew(phi);
-    let c = if t2 < 1e-8 {
-        1.0 / 12.0 + t2 / 720.0
-    } else {
-        let t = t2.sqrt();
-        1.0 / t2 - (1.0 + t.cos()) / (2.0 * t * t.sin())
-    };
-    DMat3::IDENTITY - s * 0.5 + s * s * c
-}
-
-/// What holds a node of the wire: a bracket's slot, a tube, a clamp. Its frame's X runs along
-/// the slot (the way the wire runs), Y across the slot's height, Z into its depth. Each of the
-/// node's six offsets from the holder (three of position, three of rotation, in the holder's
-/// frame) moves freely within its play and meets the holder's stiffness beyond it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Holder {
-    /// The node held.
-    pub node: usize,
-    /// The slot's centre (mm).
-    pub at: DVec3,
-    /// The slot's frame.
-    pub frame: DQuat,
-    /// Free play each way of the six offsets: along, across, into (mm), then about the slot's
-    /// axis (torque play), about its height and about its depth (radians);
-    /// `f64::INFINITY` where the holder does not hold.
-    pub play: [f64; 6],
-    /// Stiffness beyond the play: N/mm for offsets, N·mm/rad for turns.
-    pub stiffness: [f64; 6],
-}
-
-impl Holder {
-    /// A clamp: the node fixed in place and turn.
-    pub fn clamp(node: usize, at: &RodNode) -> Self {
-        Self {
-            node,
-            at: at.x,
-            frame: at.q,
-            play: [0.0; 6],
-            stiffness: [1e6, 1e6, 1e6, 1e6, 1e6, 1e6],
-        }
-    }
-
-    /// A pin: the node held in place, free to turn.
-    pub fn pin(node: usize, at: &RodNode) -> Self {
-        let mut h = Self::clamp(node, at);
-        h.play[3..].fill(f64::INFINITY);
-        h
-    }
-
-    /// The node's six offsets from the holder.
-    fn offsets(&self, n: &RodNode) -> [f64; 6] {
-        let inv = self.frame.inverse();
-        let d = inv * (n.x - self.at);
-        let t = log(inv * n.q);
-        [d.x, d.y, d.z, t.x, t.y, t.z]
-    }
-
-    /// The offsets' derivatives by the node's six increments (rows: offsets): the holder's
-    /// frame turns positions; a turn's rotation vector moves by Jl⁻¹ of itself.
-    fn jacobian(&self, n: &RodNode) -> [[f64; 6]; 6] {
-        let inv = DMat3::from_quat(self.frame.inverse());
-        let t = log(self.frame.inverse() * n.q);
-        let turn = jl_inv(t) * inv;
-        let mut jac = [[0.0; 6]; 6];
-        for c in 0..3 {
-            for r in 0..3 {
-                jac[r][c] = inv.col(c)[r];
-                jac[3 + r][3 + c] = turn.col(c)[r];
-            }
-        }
-        jac
-    }
-
-    /// Generalised force of each offset: the stiffness times how far past its play it is, and
-    /// its derivative. The edge of a play is rounded over [`EDGE_BLEND`] (a quadratic blend: a
-    /// force of a thousandth of a newton where a wire just meets a wall), so the force's
-    /// derivative has no jump for Newton's method to chatter on; a clamp (no play) is linear
-    /// through zero.
-    fn resultants(&self, c: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
-        let mut f = [0.0; 6];
-        let mut k = [0.0; 6];
-        for i in 0..6 {
-            let (play, stiff) = (self.play[i], self.stiffness[i]);
-            if play <= 0.0 {
-                f[i] = stiff * c[i];
-                k[i] = stiff;
-                continue;
-            }
-            let w = EDGE_BLEND.min(play);
-            let excess = c[i].abs() - play;
-            if excess >= 0.5 * w {
-                f[i] = stiff * excess * c[i].signum();
-                k[i] = stiff;
-            } else if excess > -0.5 * w {
-                let into = excess + 0.5 * w;
-                f[i] = stiff * into * into / (2.0 * w) * c[i].signum();
-                k[i] = stiff * into / w;
-            }
-        }
-        (f, k)
-    }
 }
 
 /// A force and a moment (about the node) applied to a node from outside.

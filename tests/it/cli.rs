@@ -34,7 +34,7 @@ fn fresh_dir(name: &str) -> std::path::PathBuf {
 }
 
 #[test]
-fn cases_lists_the_four_builtin_cases() {
+fn cases_lists_the_builtin_cases() {
     let out = orthosim(&["cases"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
@@ -42,7 +42,55 @@ fn cases_lists_the_four_builtin_cases() {
         .lines()
         .map(|l| l.split_whitespace().next().unwrap_or(""))
         .collect();
-    assert_eq!(names, ["normal", "case1", "case2", "case3"], "{text}");
+    assert_eq!(
+        names,
+        ["normal", "case1", "case2", "case3", "crowded"],
+        "{text}"
+    );
+}
+
+#[test]
+fn simulate_days_reports_the_wire_and_its_brackets() {
+    let out = succeed(&[
+        "simulate",
+        "--case",
+        "crowded",
+        "--algorithm",
+        "exact",
+        "--days",
+        "3",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(v["days"], 3.0);
+    assert_eq!(v["at_rest"], false);
+    let a = &v["appliance"];
+    assert_eq!(a["wire"]["material"], "NiTi");
+    assert_eq!(a["wire"]["size"], ".014\"");
+    assert_eq!(a["wire"]["form"], "ovoid");
+    assert_eq!(a["wires"]["lower"].as_array().unwrap().len(), 1);
+    let brackets = a["brackets"].as_array().unwrap();
+    assert_eq!(brackets.len(), 14);
+    assert_eq!(brackets[0]["fdi"], 47);
+    assert!(brackets.iter().any(|b| b["engaged"] == true));
+    for b in brackets {
+        assert_eq!(b["force_n"].as_array().unwrap().len(), 3);
+        assert_eq!(b["moment_nmm"].as_array().unwrap().len(), 3);
+    }
+    assert!(a["solve_us_per_step"][0].as_f64().unwrap() > 0.0);
+    // Days are refused where they mean nothing, and when not a number of days.
+    for bad in [
+        vec![
+            "simulate", "--case", "normal", "--model", "paper", "--days", "3",
+        ],
+        vec!["simulate", "--case", "normal", "--days=-1"],
+        vec!["simulate", "--case", "normal", "--days", "NaN"],
+    ] {
+        let out = orthosim(&bad);
+        assert!(!out.status.success(), "{bad:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(err.contains("days"), "{bad:?}: {err}");
+    }
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! The rod against beam theory, and its equilibria in slots.
 
+use super::strain::log;
 use super::*;
 
 /// A straight wire along X from 0 to `length`, `elements` elements.

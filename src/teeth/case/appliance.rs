@@ -1,6 +1,6 @@
 //! What a case file says of appliances: each arch's archwire (alloy, section, arch form), its
 //! brackets (slot, prescription, which teeth) and the wires that follow it on given days. The
-//! mechanics of each are in [`crate::appliance`]; these are the names a case is written in.
+//! mechanics of each are in the appliance module; these are the names a case is written in.
 
 use serde::{Deserialize, Deserializer, Serialize, de};
 
