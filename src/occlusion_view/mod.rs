@@ -83,6 +83,7 @@ impl Plugin for OcclusionViewPlugin {
                     overlays::draw_overlays,
                     overlays::draw_circles,
                     overlays::draw_selection,
+                    overlays::draw_appliances,
                     contact_map::update_contact_map,
                 )
                     .chain(),
