@@ -299,6 +299,43 @@ pub(super) fn draw_overlays(
     }
 }
 
+const WIRE_COLOUR: Color = Color::srgb(0.86, 0.88, 0.92);
+/// Force on a bracket drawn fully red (N).
+const BRACKET_FULL_N: f64 = 2.0;
+
+/// The archwires in their deformed shape, and each bracket's slot as a box turned as the slot is,
+/// coloured from blue (the wire passive in it) to red ([`BRACKET_FULL_N`] or more on it).
+pub(super) fn draw_appliances(
+    mut gizmos: Gizmos,
+    state: Option<Res<crate::movement::SimulationState>>,
+) {
+    let Some(sim) = state.as_ref().and_then(|s| s.sim.as_ref()) else {
+        return;
+    };
+    for w in &sim.wires {
+        let nodes = w.rod.nodes.iter().map(|n| n.x.as_vec3());
+        if w.rod.nodes.iter().all(|n| n.x.is_finite()) {
+            gizmos.linestrip(nodes, WIRE_COLOUR);
+        }
+        for (b, r) in w.brackets.iter().zip(&w.reactions) {
+            let Some(t) = sim.teeth.get(b.tooth) else {
+                continue;
+            };
+            let at = t.pose.transform_point(b.bracket.centre.as_vec3());
+            let turn = t.pose.rotation * b.bracket.frame.as_quat();
+            let f = (r.force.length() / BRACKET_FULL_N).clamp(0.0, 1.0) as f32;
+            let colour = Color::srgb(0.25 + 0.75 * f, 0.55 * (1.0 - f), 1.0 - 0.8 * f);
+            let size = Vec3::new(b.bracket.width_mm as f32, 1.2, 0.6);
+            gizmos.cube(
+                Transform::from_translation(at)
+                    .with_rotation(turn)
+                    .with_scale(size),
+                colour,
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -341,42 +378,5 @@ mod tests {
                 .to_string()
                 .contains("glass")
         );
-    }
-}
-
-const WIRE_COLOUR: Color = Color::srgb(0.86, 0.88, 0.92);
-/// Force on a bracket drawn fully red (N).
-const BRACKET_FULL_N: f64 = 2.0;
-
-/// The archwires in their deformed shape, and each bracket's slot as a box turned as the slot is,
-/// coloured from blue (the wire passive in it) to red ([`BRACKET_FULL_N`] or more on it).
-pub(super) fn draw_appliances(
-    mut gizmos: Gizmos,
-    state: Option<Res<crate::movement::SimulationState>>,
-) {
-    let Some(sim) = state.as_ref().and_then(|s| s.sim.as_ref()) else {
-        return;
-    };
-    for w in &sim.wires {
-        let nodes = w.rod.nodes.iter().map(|n| n.x.as_vec3());
-        if w.rod.nodes.iter().all(|n| n.x.is_finite()) {
-            gizmos.linestrip(nodes, WIRE_COLOUR);
-        }
-        for (b, r) in w.brackets.iter().zip(&w.reactions) {
-            let Some(t) = sim.teeth.get(b.tooth) else {
-                continue;
-            };
-            let at = t.pose.transform_point(b.bracket.centre.as_vec3());
-            let turn = t.pose.rotation * b.bracket.frame.as_quat();
-            let f = (r.force.length() / BRACKET_FULL_N).clamp(0.0, 1.0) as f32;
-            let colour = Color::srgb(0.25 + 0.75 * f, 0.55 * (1.0 - f), 1.0 - 0.8 * f);
-            let size = Vec3::new(b.bracket.width_mm as f32, 1.2, 0.6);
-            gizmos.cube(
-                Transform::from_translation(at)
-                    .with_rotation(turn)
-                    .with_scale(size),
-                colour,
-            );
-        }
     }
 }
