@@ -216,6 +216,15 @@ impl Rod {
         Self::new(nodes, size, material)
     }
 
+    /// Puts the wire's nodes back where they were (as many as it has), forgetting its tangent;
+    /// the transformation state of NiTi elements is kept (it changes only at equilibria).
+    pub fn place(&mut self, nodes: Vec<RodNode>) {
+        if nodes.len() == self.nodes.len() {
+            self.nodes = nodes;
+            self.factor = None;
+        }
+    }
+
     /// The section's stiffnesses: EA, κGA, κGA (N), GJ, EI in the arch's plane, EI across it
     /// (N·mm²).
     pub fn stiffness(&self) -> [f64; 6] {
@@ -553,6 +562,7 @@ impl Rod {
         // A fresh material tangent where the wire stands: a stale one may lack walls the wire
         // now bears on (its inverse would then exceed the walls' and the result turn negative).
         self.factor = self.tangent_factor(holders, &[], false);
+        let mut e = vec![0.0; n];
         holders
             .iter()
             .map(|h| {
@@ -570,7 +580,7 @@ impl Rod {
                 });
                 let mut inv = [[0.0; 6]; 6];
                 for col in 0..6 {
-                    let mut e = vec![0.0; n];
+                    e.fill(0.0);
                     e[h.node * DOF + col] = 1.0;
                     f.solve(&mut e);
                     for (row, line) in inv.iter_mut().enumerate() {

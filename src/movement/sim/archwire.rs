@@ -14,10 +14,11 @@
 //!
 //! **Guarantee.** With the wire converged, the forces on the brackets are the discrete rod's
 //! (see [`crate::appliance::rod`]); a tooth whose bracket is passive within its slot's play
-//! feels nothing from the wire and stops. A solve that does not converge keeps its best
-//! equilibrium and is reported in [`ArchWire::last`].
+//! feels nothing from the wire and stops. A solve that does not converge (even with
+//! [`ENGAGE_ITERATIONS`]) leaves the wire where it stood and the brackets with the last step's
+//! loads, and is reported in [`ArchWire::last`].
 
-use glam::{DMat3, DVec3};
+use glam::DVec3;
 
 use super::Simulation;
 use crate::{
@@ -25,8 +26,11 @@ use crate::{
         ArchForm, ArchSize, Bracket, Equilibrium, Holder, Prescription, Reaction, Rod, Settings,
         Slot, ToothAxes, WireMaterial, WireSize, lay,
     },
-    geometry::{Mat6, Vec6, vec6},
-    movement::MovementError,
+    geometry::{Mat6, Vec6},
+    movement::{
+        MovementError,
+        pdl::{shifted, wrench},
+    },
     teeth::{Arch, Fdi, Side, ToothKind, case::appliance::CaseAppliance},
 };
 
@@ -345,7 +349,7 @@ impl Simulation {
             tolerance_n: STEP_TOLERANCE_N,
             max_iterations: iterations,
         };
-        let before = w.rod.clone();
+        let before = w.rod.nodes.clone();
         w.last = w.rod.solve(&holders, &[], &settings);
         if !w.last.converged && iterations < ENGAGE_ITERATIONS {
             w.last = w.rod.solve(
@@ -357,13 +361,13 @@ impl Simulation {
                 },
             );
         }
-        if w.last.converged || before.nodes.is_empty() {
+        if w.last.converged {
             w.reactions = w.rod.reactions(&holders);
             w.stiffness = w.rod.holder_stiffness(&holders);
         } else {
             // No equilibrium found: the wire stays as it was and the brackets keep the last
             // step's loads (never forces from a wire out of balance).
-            w.rod = before;
+            w.rod.place(before);
         }
         w.solve_ns = clock.elapsed().as_nanos() as u64;
     }
@@ -419,29 +423,15 @@ fn world(t: &super::SimTooth) -> (glam::DQuat, DVec3) {
 }
 
 /// The wrench about `centre` of the wire's loads, and their stiffness against the body's twist
-/// about `centre` (`Tᵀ·K·T`, T carrying the twist to each slot).
+/// about `centre` (each slot's stiffness carried there).
 pub(super) fn about(loads: &[(DVec3, Reaction, Mat6)], centre: DVec3) -> (Vec6, Mat6) {
-    let mut wrench = [0.0; 6];
-    let mut stiffness = Mat6::ZERO;
-    for (at, r, k) in loads {
-        let arm = *at - centre;
-        let w = vec6(r.force, r.moment + arm.cross(r.force));
-        for (a, b) in wrench.iter_mut().zip(w) {
-            *a += b;
-        }
-        // T = [[I, −[arm]×], [0, I]]: the slot's motion under the body's twist.
-        let mut t = Mat6::identity();
-        let skew = DMat3::from_cols(
-            DVec3::new(0.0, arm.z, -arm.y),
-            DVec3::new(-arm.z, 0.0, arm.x),
-            DVec3::new(arm.y, -arm.x, 0.0),
-        );
-        for c in 0..3 {
-            for r in 0..3 {
-                t.0[r][3 + c] = -skew.col(c)[r];
-            }
-        }
-        stiffness = stiffness.add_scaled(&t.transpose().mul(k).mul(&t), 1.0);
-    }
-    (wrench, stiffness)
+    loads
+        .iter()
+        .fold(([0.0; 6], Mat6::ZERO), |(w, k), (at, r, stiffness)| {
+            let add = wrench(r.force, *at, r.moment, centre);
+            (
+                std::array::from_fn(|i| w[i] + add[i]),
+                k.add_scaled(&shifted(stiffness, *at, centre), 1.0),
+            )
+        })
 }
