@@ -424,7 +424,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
                 area: 1.0,
                 mean_spring: 1.0,
                 applied: [0.0; 6],
-                damping: None,
+                appliance_stiffness: None,
             },
             PdlBody {
                 centre: c,
@@ -432,7 +432,7 @@ pub fn bite(case: &str, teeth: &[Posed], settle: bool, opening_mm: f32) -> Bite 
                 area: 1.0,
                 mean_spring: 1.0,
                 applied: vec6(DVec3::Y, DVec3::ZERO),
-                damping: None,
+                appliance_stiffness: None,
             },
         ];
         let solve = solve_contacts(&bodies, &contacts, None, &params);

@@ -102,6 +102,8 @@ pub struct InspectReport {
     pub occlusal_min_gap_mm: f32,
     /// Overjet, overbite and molar relation measured on the teeth present, where they stand.
     pub occlusion: MeasuredOcclusion,
+    /// Little's irregularity index and arch-length discrepancy, upper then lower arch.
+    pub alignment: [ArchAlignment; 2],
     /// Teeth read from mesh files, with what was repaired in each.
     pub imported: Vec<ImportedMesh>,
     /// Where the case's mesh and scan files were placed (empty without them).
@@ -109,6 +111,67 @@ pub struct InspectReport {
     /// What the import of each labelled scan changed in its labels or left out (empty without
     /// scans).
     pub scans: Vec<crate::teeth::ScanReport>,
+}
+
+/// How aligned an arch's teeth stand.
+#[derive(Clone, Debug, Serialize)]
+pub struct ArchAlignment {
+    /// "upper" or "lower".
+    pub arch: &'static str,
+    /// Little's irregularity index (mm; None when an anterior tooth is missing).
+    pub irregularity_mm: Option<f32>,
+    /// Its five displacements, canine to canine: `(a, b, mm)`.
+    pub contacts: Vec<(u8, u8, f32)>,
+    /// Space available minus space required, first molar to first molar (mm; negative:
+    /// crowding; None without both first molars).
+    pub arch_length_discrepancy_mm: Option<f32>,
+}
+
+fn alignment(d: &Dentition) -> [ArchAlignment; 2] {
+    use crate::teeth::{
+        Arch,
+        arch::irregularity::{Anterior, displacements},
+    };
+    let anteriors: Vec<Anterior> = d
+        .visible()
+        .map(|t| Anterior {
+            fdi: t.fdi,
+            geometry: &t.geometry,
+            pose: t.pose,
+        })
+        .collect();
+    let posed = super::measures::Posed::of_dentition(d);
+    let arches = super::measures::arch_positions(&posed);
+    let width = |f: crate::teeth::Fdi| {
+        d.tooth(f)
+            .map_or(f32::NAN, |t| t.geometry.anatomy.mesiodistal)
+    };
+    let bolton = super::measures::bolton(width, [&arches[0], &arches[1]]);
+    let one = |arch: Arch, name: &'static str, discrepancy: f32| {
+        let pairs = displacements(&anteriors, &d.contact_points, arch);
+        ArchAlignment {
+            arch: name,
+            irregularity_mm: pairs.map(|p| p.iter().map(|c| c.mm).sum()),
+            contacts: pairs.map_or_else(Vec::new, |p| {
+                p.iter()
+                    .map(|c| (c.a.number(), c.b.number(), c.mm))
+                    .collect()
+            }),
+            arch_length_discrepancy_mm: discrepancy.is_finite().then_some(discrepancy),
+        }
+    };
+    [
+        one(
+            Arch::Upper,
+            "upper",
+            bolton.arch_length_discrepancy_upper_mm,
+        ),
+        one(
+            Arch::Lower,
+            "lower",
+            bolton.arch_length_discrepancy_lower_mm,
+        ),
+    ]
 }
 
 /// A tooth read from a mesh file.
@@ -224,6 +287,7 @@ pub fn inspect(d: &Dentition) -> InspectReport {
         occlusal_max_penetration_mm: occlusal,
         occlusal_min_gap_mm: occlusal_gap,
         occlusion: measure_occlusion(d),
+        alignment: alignment(d),
         imported: d
             .imported
             .iter()

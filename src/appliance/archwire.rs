@@ -55,6 +55,101 @@ impl ArchSize {
     }
 }
 
+/// `form` sized and placed to pass nearest the slot centres `points` (world) in the occlusal
+/// plane: the molar width, depth and forward shift (z0) that least-squares the points' distances
+/// to the form (Gauss–Newton from [`ArchSize::fit`]'s extremes). The form keeps its proportions;
+/// only its size and place are the patient's. `None` as for [`ArchSize::fit`].
+pub fn fit_form(form: ArchForm, points: &[DVec3]) -> Option<(ArchSize, f64)> {
+    let start = ArchSize::fit(points)?;
+    let (left, right) = (
+        points.iter().max_by(|a, b| a.x.total_cmp(&b.x))?,
+        points.iter().min_by(|a, b| a.x.total_cmp(&b.x))?,
+    );
+    let residuals = |q: [f64; 3]| -> Vec<f64> {
+        let size = ArchSize {
+            molar_width_mm: q[0],
+            depth_mm: q[1],
+        };
+        points
+            .iter()
+            .map(|&p| {
+                let (at, t) = nearest_on_form(form, &size, p.y, q[2], p);
+                (p - at).dot(t.cross(DVec3::Y))
+            })
+            .collect()
+    };
+    let q0 = [
+        start.molar_width_mm,
+        start.depth_mm,
+        0.5 * (left.z + right.z),
+    ];
+    // Within a wire size or two of the brackets' own extent, and a few millimetres of their
+    // place: a preformed form is chosen, not drawn to any shape.
+    let bounded = |q: [f64; 3]| {
+        [
+            q[0].clamp(0.85 * q0[0], 1.15 * q0[0]),
+            q[1].clamp(0.85 * q0[1], 1.15 * q0[1]),
+            q[2].clamp(q0[2] - 5.0, q0[2] + 5.0),
+        ]
+    };
+    let mut q = q0;
+    let cost = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+    let mut r = residuals(q);
+    for _ in 0..30 {
+        // Forward-difference Jacobian, then the 3×3 normal equations.
+        let h = 1e-4;
+        let cols: Vec<Vec<f64>> = (0..3)
+            .map(|j| {
+                let mut e = q;
+                e[j] += h;
+                residuals(e)
+                    .iter()
+                    .zip(&r)
+                    .map(|(a, b)| (a - b) / h)
+                    .collect()
+            })
+            .collect();
+        let mut a = glam::DMat3::ZERO;
+        let mut g = DVec3::ZERO;
+        for i in 0..3 {
+            for j in 0..3 {
+                let v: f64 = cols[i].iter().zip(&cols[j]).map(|(x, y)| x * y).sum();
+                *a.col_mut(j).as_mut().get_mut(i).expect("3×3") = v;
+            }
+            g[i] = cols[i].iter().zip(&r).map(|(x, y)| x * y).sum();
+        }
+        if a.determinant().abs() < 1e-12 {
+            break;
+        }
+        // Gauss–Newton's step, halved until it lowers the cost.
+        let mut step = a.inverse() * -g;
+        let mut taken = None;
+        for _ in 0..12 {
+            let next = bounded([q[0] + step.x, q[1] + step.y, q[2] + step.z]);
+            let r_next = residuals(next);
+            if cost(&r_next) < cost(&r) {
+                taken = Some((next, r_next));
+                break;
+            }
+            step *= 0.5;
+        }
+        let Some((next, r_next)) = taken else {
+            break;
+        };
+        (q, r) = (next, r_next);
+        if step.length() < 1e-6 {
+            break;
+        }
+    }
+    Some((
+        ArchSize {
+            molar_width_mm: q[0],
+            depth_mm: q[1],
+        },
+        q[2],
+    ))
+}
+
 impl ArchForm {
     /// Every form, for pickers.
     pub const ALL: [Self; 3] = [Self::Ovoid, Self::Tapered, Self::Square];
@@ -101,6 +196,50 @@ impl ArchForm {
     }
 }
 
+/// The place of `form` of `size` at height `y`, shifted forwards by `z0`, nearest to `p` in the
+/// occlusal plane (its straight tails included), and the form's unit tangent there, running from
+/// the patient's right to left (+x).
+pub fn nearest_on_form(
+    form: ArchForm,
+    size: &ArchSize,
+    y: f64,
+    z0: f64,
+    p: DVec3,
+) -> (DVec3, DVec3) {
+    let half = 0.5 * size.molar_width_mm;
+    let at = |x: f64| form.point(size, x) + DVec3::new(0.0, y, z0);
+    let tangent = |x: f64| (at(x + 1e-5) - at(x - 1e-5)).normalize();
+    let flat = DVec3::new(p.x, y, p.z);
+    let d2 = |x: f64| at(x).distance_squared(flat);
+    // Coarse samples, then golden-section search around the best (the distance is unimodal
+    // within a sample's neighbourhood on these smooth forms).
+    let samples = 400;
+    let xs = |i: usize| -half + size.molar_width_mm * i as f64 / samples as f64;
+    let best = (0..=samples)
+        .min_by(|&a, &b| d2(xs(a)).total_cmp(&d2(xs(b))))
+        .unwrap_or(0);
+    let (mut lo, mut hi) = (xs(best.saturating_sub(1)), xs((best + 1).min(samples)));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (a, b) = (hi - g * (hi - lo), lo + g * (hi - lo));
+        if d2(a) < d2(b) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    let x = 0.5 * (lo + hi);
+    // Past a molar end, the straight tail.
+    for end in [-half, half] {
+        let t = tangent(end);
+        let beyond = (flat - at(end)).dot(t) * end.signum();
+        if (x - end).abs() < 1e-6 * size.molar_width_mm.max(1.0) && beyond > 0.0 {
+            return (at(end) + t * (flat - at(end)).dot(t), t);
+        }
+    }
+    (at(x), tangent(x))
+}
+
 /// A wire laid through brackets: its passive nodes and, per bracket, the node it holds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Laid {
@@ -111,8 +250,19 @@ pub struct Laid {
 }
 
 /// Lays `form` of `size` at height `y`, shifted forwards by `z0` (the molars' line), through
-/// brackets at `points` (world slot centres, in any order): see the module doc.
-pub fn lay(form: ArchForm, size: &ArchSize, y: f64, z0: f64, points: &[DVec3]) -> Laid {
+/// brackets at `points` (world slot centres, in any order): see the module doc. `offsets` (one
+/// per point, or empty for none) individualise the wire: it passes that far outside the form
+/// (mm, in the occlusal plane) at each bracket's place, the offset blended between brackets by a
+/// Catmull–Rom spline of arc length and held beyond the end brackets, as a clinician coordinates
+/// a preformed wire to the patient's arch.
+pub fn lay(
+    form: ArchForm,
+    size: &ArchSize,
+    y: f64,
+    z0: f64,
+    points: &[DVec3],
+    offsets: &[f64],
+) -> Laid {
     let half = 0.5 * size.molar_width_mm;
     let at = |x: f64| form.point(size, x) + DVec3::new(0.0, y, z0);
     // The form sampled finely by x, then measured along its length.
@@ -166,11 +316,56 @@ pub fn lay(form: ArchForm, size: &ArchSize, y: f64, z0: f64, points: &[DVec3]) -
     }
     stations.sort_by(f64::total_cmp);
     stations.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
-    let nodes = stations
+    // The individual offset along the arc: Catmull–Rom through the brackets' offsets.
+    let mut knots: Vec<(f64, f64)> = at_brackets
+        .iter()
+        .zip(offsets.iter().chain(std::iter::repeat(&0.0)))
+        .map(|(s, d)| (*s, *d))
+        .collect();
+    knots.sort_by(|a, b| a.0.total_cmp(&b.0));
+    knots.dedup_by(|a, b| (a.0 - b.0).abs() < 1e-9);
+    let offset_at = |s: f64| -> f64 {
+        if offsets.is_empty() || knots.is_empty() {
+            return 0.0;
+        }
+        let n = knots.len();
+        if s <= knots[0].0 {
+            return knots[0].1;
+        }
+        if s >= knots[n - 1].0 {
+            return knots[n - 1].1;
+        }
+        let k = knots.partition_point(|q| q.0 <= s).clamp(1, n - 1);
+        let (s0, d0) = knots[k - 1];
+        let (s1, d1) = knots[k];
+        let slope = |i: usize| -> f64 {
+            let (a, b) = (knots[i.saturating_sub(1)], knots[(i + 1).min(n - 1)]);
+            if b.0 > a.0 {
+                (b.1 - a.1) / (b.0 - a.0)
+            } else {
+                0.0
+            }
+        };
+        let h = s1 - s0;
+        let t = (s - s0) / h;
+        let (t2, t3) = (t * t, t * t * t);
+        (2.0 * t3 - 3.0 * t2 + 1.0) * d0
+            + (t3 - 2.0 * t2 + t) * h * slope(k - 1)
+            + (-2.0 * t3 + 3.0 * t2) * d1
+            + (t3 - t2) * h * slope(k)
+    };
+    let places: Vec<DVec3> = stations
         .iter()
         .map(|&s| {
             let (p, t) = point_at(s);
-            RodNode::along(p, t, DVec3::Y)
+            p + t.cross(DVec3::Y).normalize() * offset_at(s)
+        })
+        .collect();
+    let last = places.len().saturating_sub(1);
+    let nodes = (0..places.len())
+        .map(|i| {
+            let t = places[(i + 1).min(last)] - places[i.saturating_sub(1)];
+            RodNode::along(places[i], t, DVec3::Y)
         })
         .collect();
     let held = at_brackets
@@ -198,7 +393,7 @@ mod tests {
             molar_width_mm: 46.0,
             depth_mm: 26.0,
         };
-        let laid = lay(ArchForm::Ovoid, &size, 0.0, 0.0, &[]);
+        let laid = lay(ArchForm::Ovoid, &size, 0.0, 0.0, &[], &[]);
         let total = laid.nodes.len() - 1;
         let mut points = Vec::new();
         let mut frames = Vec::new();
@@ -237,7 +432,7 @@ mod tests {
     #[test]
     fn a_wire_through_aligned_brackets_is_passive_and_one_displaced_bracket_is_pulled_back() {
         let (size, points, frames) = aligned();
-        let laid = lay(ArchForm::Ovoid, &size, 0.0, 0.0, &points);
+        let laid = lay(ArchForm::Ovoid, &size, 0.0, 0.0, &points, &[]);
         assert_eq!(laid.held.len(), 12);
         for (p, &k) in points.iter().zip(&laid.held) {
             // To the fine sampling of the form.

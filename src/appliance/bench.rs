@@ -59,7 +59,7 @@ pub fn appliance_bench_with(
     };
     let form = ArchForm::Ovoid;
     // Slot centres spaced along the form, each up to 1 mm off it in a fixed pattern.
-    let along = lay(form, &size, 0.0, 0.0, &[]);
+    let along = lay(form, &size, 0.0, 0.0, &[], &[]);
     let n = along.nodes.len();
     let fdis: Vec<Fdi> = (1..=7)
         .rev()
@@ -92,7 +92,7 @@ pub fn appliance_bench_with(
         b.centre = node.x + off;
         brackets.push(b);
     }
-    let laid = lay(form, &size, 0.0, 0.0, &points);
+    let laid = lay(form, &size, 0.0, 0.0, &points, &[]);
     let holders = |shift: f64| -> Vec<Holder> {
         brackets
             .iter()

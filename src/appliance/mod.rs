@@ -14,7 +14,7 @@ pub mod prescription;
 pub mod rod;
 pub mod section;
 
-pub use archwire::{ArchForm, ArchSize, Laid, lay};
+pub use archwire::{ArchForm, ArchSize, Laid, fit_form, lay, nearest_on_form};
 pub use bracket::{Bracket, Slot, ToothAxes, binding_angle_rad, torque_play_rad};
 pub use material::{Transformation, WireMaterial};
 pub use prescription::{BracketAngles, Prescription};

@@ -166,4 +166,22 @@ fn print_table(report: &InspectReport) {
     for (what, why) in &o.unmeasured {
         println!("  {what}: {why}");
     }
+    for a in &report.alignment {
+        let contacts: Vec<String> = a
+            .contacts
+            .iter()
+            .map(|(x, y, mm)| format!("{x}-{y} {mm:.2}"))
+            .collect();
+        println!(
+            "{} arch: Little's irregularity index {}{}, arch-length discrepancy {}",
+            a.arch,
+            show(a.irregularity_mm, false),
+            if contacts.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", contacts.join(", "))
+            },
+            show(a.arch_length_discrepancy_mm, true)
+        );
+    }
 }

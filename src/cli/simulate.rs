@@ -171,6 +171,17 @@ fn print_table(r: &SimulationReport) {
                 if b.engaged { "" } else { "  (passive)" }
             );
         }
+        for (arch, series) in [
+            ("upper", &a.irregularity_mm.upper),
+            ("lower", &a.irregularity_mm.lower),
+        ] {
+            if let (Some(first), Some(last)) = (series.first(), series.last()) {
+                println!(
+                    "{arch} irregularity index (Little): {:.2} mm on day {:.0}, {:.2} mm on day {:.0}",
+                    first[1], first[0], last[1], last[0]
+                );
+            }
+        }
         println!(
             "wire solve {:.0} µs per step (median; most {:.0}), {:.2}× the collision step{}",
             a.solve_us_per_step[0],

@@ -173,6 +173,39 @@ pub struct ApplianceReport {
     pub solve_over_collision: f64,
     /// Whether every wire solve of the run converged.
     pub converged: bool,
+    /// Little's irregularity index of each arch over the run: `[day, mm]` at the start, at each
+    /// whole day and at the end (empty for an arch missing an anterior tooth).
+    pub irregularity_mm: Irregularity,
+}
+
+/// Little's irregularity index of both arches over a run (see
+/// [`crate::teeth::arch::irregularity`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Irregularity {
+    /// Upper arch: `[day, mm]`.
+    pub upper: Vec<[f64; 2]>,
+    /// Lower arch: `[day, mm]`.
+    pub lower: Vec<[f64; 2]>,
+}
+
+impl Irregularity {
+    /// Adds both arches' index where the teeth of `sim` stand now.
+    pub fn record(&mut self, sim: &Simulation) {
+        for (arch, series) in [
+            (Arch::Upper, &mut self.upper),
+            (Arch::Lower, &mut self.lower),
+        ] {
+            if let Some(mm) = sim.irregularity_mm(arch) {
+                series.push([sim.elapsed_days, f64::from(mm)]);
+            }
+        }
+    }
+
+    /// The first day the lower arch's index is under `mm`, if it gets there: the time to
+    /// alignment as clinical trials count it.
+    pub fn lower_aligned_day(&self, mm: f64) -> Option<f64> {
+        self.lower.iter().find(|p| p[1] < mm).map(|p| p[0])
+    }
 }
 
 /// How long a run may go.
@@ -268,6 +301,7 @@ fn appliance_report(
     collision_steps: Vec<f64>,
     wire_steps: Vec<f64>,
     converged: bool,
+    irregularity_mm: Irregularity,
 ) -> Option<ApplianceReport> {
     let last = sim
         .wires
@@ -316,6 +350,7 @@ fn appliance_report(
             0.0
         },
         converged,
+        irregularity_mm,
     })
 }
 
@@ -379,6 +414,9 @@ pub fn run_case_for(
     let mut collision_steps = Vec::new();
     let mut wire_steps = Vec::new();
     let mut converged = true;
+    let mut irregularity = Irregularity::default();
+    irregularity.record(&sim);
+    let mut next_day = 1.0;
     while sim.steps < max_steps && limit.max_days.is_none_or(|d| sim.elapsed_days < d - 1e-9) {
         let out = sim.step();
         collision_ns += out.collision_ns;
@@ -389,9 +427,24 @@ pub fn run_case_for(
             converged &= sim.wires.iter().all(|w| w.last.converged);
         }
         progress(sim.steps);
+        if sim.elapsed_days >= next_day {
+            irregularity.record(&sim);
+            next_day = sim.elapsed_days.floor() + 1.0;
+        }
         if at_rest {
             break;
         }
+    }
+    if irregularity
+        .lower
+        .last()
+        .is_some_and(|p| p[0] < sim.elapsed_days)
+        || irregularity
+            .upper
+            .last()
+            .is_some_and(|p| p[0] < sim.elapsed_days)
+    {
+        irregularity.record(&sim);
     }
     let elapsed = start.elapsed().as_secs_f64() * 1e6;
     let steps = sim.steps.max(1) as f64;
@@ -428,7 +481,7 @@ pub fn run_case_for(
         impacts: sim.total_impacts,
         energy_lost_uj: sim.total_energy_lost_uj,
         teeth: tooth_travel(&sim),
-        appliance: appliance_report(&sim, collision_steps, wire_steps, converged),
+        appliance: appliance_report(&sim, collision_steps, wire_steps, converged, irregularity),
     };
     Ok(CaseRun {
         report,

@@ -6,7 +6,10 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::{
-    arch::{ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces},
+    arch::{
+        ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces,
+        irregularity::{Anterior, ContactPoints},
+    },
     case::{CaseError, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
     import::Repairs,
@@ -98,6 +101,12 @@ pub struct Dentition {
     /// present teeth ([`BetaArch::fit`]), which slides teeth and gives imported teeth their
     /// buccal axis. The bite opening raises the teeth, not the curve in x–z.
     pub arch_forms: [BetaArch; 2],
+    /// The anterior teeth's anatomic contact points for Little's irregularity index.
+    pub contact_points: ContactPoints,
+    /// Where each procedural tooth stands aligned: its place in the arrangement (the bite
+    /// opening included), before the case's offsets. Imported teeth have none (their aligned
+    /// place is not known).
+    pub setup: std::collections::BTreeMap<Fdi, Pose>,
     /// What was repaired in each imported tooth mesh (teeth with a mesh file only).
     pub imported: std::collections::BTreeMap<Fdi, Repairs>,
     /// Where the case's mesh and scan files were placed.
@@ -138,6 +147,9 @@ impl Dentition {
         let mut imported_repairs = std::collections::BTreeMap::new();
         let mut orientation = Vec::new();
         let mut scans = Vec::new();
+        let patient_teeth_of: Vec<Fdi> = patient
+            .as_ref()
+            .map_or_else(Vec::new, |p| p.teeth.iter().map(|(f, _)| *f).collect());
         if let Some(patient) = patient {
             // Each imported tooth's buccal axis comes from the arch as it is: the arrangement's
             // forms fitted to the cervical centres of the teeth present. An imported tooth's
@@ -165,10 +177,30 @@ impl Dentition {
             orientation = patient.orientation;
             scans = patient.scans;
         }
+        // The anatomic contact points while the arrangement's teeth stand aligned (before the
+        // case's offsets); imported crowns take theirs from their shape.
+        let contact_points = {
+            let anteriors: Vec<Anterior> = teeth
+                .iter()
+                .filter(|t| !t.extracted)
+                .map(|t| Anterior {
+                    fdi: t.fdi,
+                    geometry: &t.geometry,
+                    pose: t.pose,
+                })
+                .collect();
+            let imported = |f: Fdi| patient_teeth_of.contains(&f);
+            ContactPoints::new(&anteriors, |f| !imported(f))
+        };
         let lift = Vec3::Y * case.bite_opening_mm.0;
         for tooth in teeth.iter_mut().filter(|t| t.fdi.arch() == Arch::Upper) {
             tooth.pose.translation += lift;
         }
+        let setup = teeth
+            .iter()
+            .filter(|t| !patient_teeth_of.contains(&t.fdi))
+            .map(|t| (t.fdi, t.pose))
+            .collect();
         for tooth in &mut teeth {
             if let Some(offset) = case.offsets.0.get(&tooth.fdi) {
                 let [m, b, o] = tooth.anatomical_axes();
@@ -218,6 +250,8 @@ impl Dentition {
             groups,
             arrangement: arrangement.measures,
             arch_forms,
+            contact_points,
+            setup,
             imported: imported_repairs,
             orientation,
             scans,

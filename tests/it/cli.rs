@@ -78,6 +78,17 @@ fn simulate_days_reports_the_wire_and_its_brackets() {
         assert_eq!(b["moment_nmm"].as_array().unwrap().len(), 3);
     }
     assert!(a["solve_us_per_step"][0].as_f64().unwrap() > 0.0);
+    // Little's index of each arch, day by day: the lower arch's crowding starts at 5–6 mm and
+    // falls; the upper arch stands aligned.
+    let lower = a["irregularity_mm"]["lower"].as_array().unwrap();
+    assert_eq!(lower.len(), 4, "{lower:?}");
+    let mm = |p: &serde_json::Value| p[1].as_f64().unwrap();
+    assert_eq!(lower[0][0], 0.0);
+    assert_eq!(lower[3][0], 3.0);
+    assert!((5.0..6.0).contains(&mm(&lower[0])), "{lower:?}");
+    assert!(mm(&lower[3]) < mm(&lower[0]), "{lower:?}");
+    let upper = a["irregularity_mm"]["upper"].as_array().unwrap();
+    assert!(upper.iter().all(|p| mm(p) < 0.01), "{upper:?}");
     // Days are refused where they mean nothing, and when not a number of days.
     for bad in [
         vec![
@@ -98,6 +109,18 @@ fn inspect_normal_meets_the_arrangement_figures() {
     let out = succeed(&["inspect", "--case", "normal", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
     assert_eq!(v["case"], "normal");
+    // Aligned rows: Little's index 0 with its five contacts, and the arch-length discrepancy
+    // of teeth in contact (a millimetre or so).
+    for (k, arch) in ["upper", "lower"].iter().enumerate() {
+        let a = &v["alignment"][k];
+        assert_eq!(a["arch"], *arch);
+        assert!(a["irregularity_mm"].as_f64().unwrap() < 0.01, "{a}");
+        assert_eq!(a["contacts"].as_array().unwrap().len(), 5);
+        assert!(
+            a["arch_length_discrepancy_mm"].as_f64().unwrap().abs() < 3.0,
+            "{a}"
+        );
+    }
     let teeth = v["teeth"].as_array().unwrap();
     assert_eq!(teeth.len(), 32);
     for t in teeth {
@@ -528,10 +551,14 @@ fn simulate_takes_either_model_and_validate_prints_its_rows() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "pdl");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 18);
+    assert_eq!(rows.len(), 19);
     assert!(
         rows.iter()
             .any(|r| r["name"] == "niti_unloading_force_n" && r["tooth"] == 0)
+    );
+    assert!(
+        rows.iter()
+            .any(|r| r["name"] == "crowded_alignment_days" && r["unit"] == "days")
     );
     for r in rows {
         for key in ["name", "tooth", "value", "unit", "reference", "source"] {
@@ -667,7 +694,7 @@ fn report_writes_every_file_its_page_refers_to() {
     }
     assert_eq!(
         v["biomechanics"]["rows"].as_array().map(|r| r.len()),
-        Some(18)
+        Some(19)
     );
     assert!(html.contains("The bite") && html.contains("biomechanics"));
     let fit = v["tree_fit"].as_array().unwrap();

@@ -10,7 +10,12 @@
 use glam::{DMat3, DVec3};
 
 use super::stiffness::PdlStiffness;
+
 use crate::geometry::{Mat6, Vec6, halves, jacobi_eigen, vec6};
+
+/// The length rotations are weighed at when a twist's speed is held to the saturated
+/// ligament's ([`PdlBody::twist`]): about a root's length (mm).
+pub const TWIST_ARM_MM: f64 = 10.0;
 
 /// `diag(R, R) · M · diag(R, R)ᵀ`: a 6×6 stiffness or compliance turned by `r`.
 pub fn rotated(m: &Mat6, r: DMat3) -> Mat6 {
@@ -141,11 +146,11 @@ pub struct PdlBody {
     pub mean_spring: f64,
     /// Applied wrench about the centre (N, N·mm).
     pub applied: Vec6,
-    /// What an appliance whose force falls as the body moves makes of its motion:
-    /// `(I + rate·C·K)⁻¹` for the appliance's stiffness K, so that a step moves the body where
-    /// the appliance's force at the step's end would (backward Euler) and no stiff wire makes it
-    /// overshoot; None: no such appliance.
-    pub damping: Option<Mat6>,
+    /// The stiffness K about the centre of an appliance whose force falls as the body moves
+    /// (N/mm, N·mm/rad): a step then moves the body as the load at the step's end drives it
+    /// (backward Euler, see [`PdlBody::twist`]), so that no stiff wire makes it overshoot; None:
+    /// no such appliance.
+    pub appliance_stiffness: Option<Mat6>,
 }
 
 impl PdlBody {
@@ -157,17 +162,39 @@ impl PdlBody {
     /// The twist per step (mm, rad about the centre) under wrench `w`: `rate` × the elastic
     /// twist, shrunk so that the pressure drops by the threshold (zero below it) and no faster
     /// than at `saturation_kpa`.
+    ///
+    /// With an appliance's stiffness K the step is backward Euler for the linear part,
+    /// v = (I + g·C·K)⁻¹ g·C·w with g = rate·(p − threshold)/p, so that no stiff wire makes the
+    /// tooth overshoot where its force falls; that twist is then held to the speed of the
+    /// saturated ligament (its size, rotations weighed at [`TWIST_ARM_MM`], at most that of the
+    /// undamped twist at `saturation_kpa`). A stiff wire far from passive so moves a tooth at the
+    /// ligament's saturated speed, not at the crawl its stiffness alone would allow.
     pub fn twist(&self, w: &Vec6, rate: f64, threshold_kpa: f64, saturation_kpa: f64) -> Vec6 {
         let p = self.pressure_kpa(w);
         if p.is_nan() || p <= threshold_kpa {
             return [0.0; 6];
         }
-        let drive = (p - threshold_kpa).min((saturation_kpa - threshold_kpa).max(0.0));
-        let scale = rate * drive / p;
-        let t = self.compliance.mul_vec(w).map(|v| v * scale);
-        match &self.damping {
-            Some(d) => d.mul_vec(&t),
-            None => t,
+        let cw = self.compliance.mul_vec(w);
+        let cap = rate * (saturation_kpa - threshold_kpa).max(0.0) / p;
+        let linear = rate * (p - threshold_kpa) / p;
+        let Some(k) = &self.appliance_stiffness else {
+            let g = linear.min(cap);
+            return cw.map(|v| v * g);
+        };
+        let damped = Mat6::identity()
+            .add_scaled(&self.compliance.mul(k), linear)
+            .solve(&cw.map(|v| v * linear))
+            .unwrap_or([0.0; 6]);
+        let size = |t: &Vec6| {
+            let (v, r) = halves(t);
+            (v.length_squared() + (r * TWIST_ARM_MM).length_squared()).sqrt()
+        };
+        let most = size(&cw) * cap;
+        let s = size(&damped);
+        if s > most && s > 0.0 {
+            damped.map(|v| v * most / s)
+        } else {
+            damped
         }
     }
 

@@ -162,7 +162,7 @@ mod tests {
                 area: 1.0,
                 mean_spring: 1.0,
                 applied: vec6(DVec3::X * if i == 0 { push } else { 0.0 }, DVec3::ZERO),
-                damping: None,
+                appliance_stiffness: None,
             })
             .collect()
     }

@@ -9,7 +9,7 @@
 //! stiffness passes 2), so each bonded body also carries the wire's stiffness at its bracket
 //! (the slot's walls in series with the re-balanced wire, [`Rod::holder_stiffness`]) and moves
 //! by backward Euler: where the wire's force at the step's end balances the ligament's motion
-//! ([`crate::movement::pdl::PdlBody::damping`]). Teeth are coupled to each other through the wire
+//! ([`crate::movement::pdl::PdlBody::twist`]). Teeth are coupled to each other through the wire
 //! only via its solve at the next step (the stiffness is each bracket's own block).
 //!
 //! **Guarantee.** With the wire converged, the forces on the brackets are the discrete rod's
@@ -18,13 +18,14 @@
 //! [`ENGAGE_ITERATIONS`]) leaves the wire where it stood and the brackets with the last step's
 //! loads, and is reported in [`ArchWire::last`].
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
 use super::Simulation;
 use crate::{
+    appliance::bracket::WALL_N_PER_MM,
     appliance::{
-        ArchForm, ArchSize, Bracket, Equilibrium, Holder, Prescription, Reaction, Rod, Settings,
-        Slot, ToothAxes, WireMaterial, WireSize, lay,
+        ArchForm, ArchSize, Bracket, Equilibrium, Holder, Laid, Prescription, Reaction, Rod,
+        Settings, Slot, ToothAxes, WireMaterial, WireSize, fit_form, lay, nearest_on_form,
     },
     geometry::{Mat6, Vec6},
     movement::{
@@ -40,6 +41,12 @@ pub const STEP_TOLERANCE_N: f64 = 1e-4;
 /// Most Newton iterations of a step's solve, before it tries again with
 /// [`ENGAGE_ITERATIONS`].
 pub const STEP_ITERATIONS: usize = 40;
+/// Farthest a bracket is moved up or down its tooth from the bracket point to level its slot
+/// (mm): about a third of a crown's height.
+pub const MAX_HEIGHT_SHIFT_MM: f64 = 2.5;
+/// How far the wire slides each way through the bracket carrying its stop before the stop bears
+/// on the bracket (mm): a stop crimped on the wire half a millimetre from each side.
+pub const STOP_PLAY_MM: f64 = 0.5;
 /// Most Newton iterations when a wire is engaged, or a step's solve needs more.
 pub const ENGAGE_ITERATIONS: usize = 200;
 
@@ -100,8 +107,18 @@ pub struct ArchWire {
     pub stiffness: Vec<[[f64; 6]; 6]>,
     /// How the last solve ended.
     pub last: Equilibrium,
+    /// The bracket whose crimped stop keeps the wire from sliding round the arch (the one
+    /// nearest the midline): the wire slides [`STOP_PLAY_MM`] each way through it, and freely
+    /// through the others.
+    pub stop: Option<usize>,
     /// The arch form's size and place, kept for the wires that follow.
     pub form: (ArchSize, f64, f64),
+    /// Each bracket's slot centre where its tooth stands aligned (world; where it stands now for
+    /// a tooth with no setup): the wires that follow are laid through these.
+    pub aligned_slots: Vec<DVec3>,
+    /// Per bracket, whether the wire is coordinated to pass through its aligned slot (its tooth
+    /// has a setup) or keeps to the form there.
+    pub individual: Vec<bool>,
     /// Wires still to come: the clinical day each is engaged, and the wire.
     pub sequence: Vec<(f64, WireChoice)>,
     /// The wires engaged so far: the day each was, and the wire.
@@ -163,54 +180,88 @@ impl Simulation {
                 chosen.len()
             )));
         }
+        // Where each tooth stands aligned (its setup) if known: brackets are bonded there as
+        // indirect bonding on a setup places them, so that the wire at rest holds the teeth in
+        // that row. A tooth with no setup keeps its bracket point and the prescription as they
+        // are.
+        let setups: Vec<Option<(DQuat, DVec3)>> = chosen
+            .iter()
+            .map(|&i| {
+                self.setup
+                    .get(&self.teeth[i].fdi)
+                    .map(|p| (p.rotation.as_dquat().normalize(), p.translation.as_dvec3()))
+            })
+            .collect();
         let mut brackets = Vec::new();
-        let mut points = Vec::new();
         for &i in &chosen {
             let t = &self.teeth[i];
-            let Some(p) = t.pdl.as_ref() else {
+            if t.pdl.is_none() {
                 return Err(MovementError::Appliance(format!(
                     "tooth {} has no ligament: brackets need the PDL movement model",
                     t.fdi
                 )));
-            };
-            let frame = &t.shape.geometry.frame;
-            let mesial = (frame.mesiodistal * t.fdi.local_x_mesial_sign()).as_dvec3();
-            let right = t.fdi.side() == Side::Right;
-            let axes = ToothAxes {
-                buccal: frame.buccolingual.as_dvec3(),
-                along: if right { mesial } else { -mesial },
-                along_is_mesial: right,
-            };
-            let bracket = Bracket::place(
-                arch,
-                t.fdi.kind(),
-                p.bracket.as_dvec3(),
-                &axes,
-                choice.prescription,
-                choice.slot,
-            );
-            let (rotation, translation) = world(t);
-            points.push(translation + rotation * bracket.centre);
+            }
             brackets.push(Bonded {
                 tooth: i,
                 fdi: t.fdi,
-                bracket,
+                bracket: self.placed_bracket(i, choice, None),
                 node: 0,
             });
         }
-        let size = ArchSize::fit(&points).ok_or_else(|| {
+        let pose_of = |k: usize| setups[k].unwrap_or_else(|| world(&self.teeth[chosen[k]]));
+        let slot_at = |k: usize, b: &Bracket| {
+            let (r, x) = pose_of(k);
+            x + r * b.centre
+        };
+        // Heights: each slot level with the others' mean where its tooth stands aligned.
+        let level = |brackets: &mut Vec<Bonded>| {
+            let y = (0..brackets.len())
+                .map(|k| slot_at(k, &brackets[k].bracket).y)
+                .sum::<f64>()
+                / brackets.len() as f64;
+            for (k, b) in brackets.iter_mut().enumerate() {
+                let Some((r, _)) = setups[k] else {
+                    continue;
+                };
+                let axis = self.teeth[b.tooth]
+                    .shape
+                    .geometry
+                    .frame
+                    .long_axis
+                    .as_dvec3();
+                let rise = (r * axis).y;
+                if rise.abs() > 0.5 {
+                    let shift = ((y - slot_at(k, &b.bracket).y) / rise)
+                        .clamp(-MAX_HEIGHT_SHIFT_MM, MAX_HEIGHT_SHIFT_MM);
+                    b.bracket.centre += axis * shift;
+                }
+            }
+        };
+        level(&mut brackets);
+        let points: Vec<DVec3> = (0..brackets.len())
+            .map(|k| slot_at(k, &brackets[k].bracket))
+            .collect();
+        let (size, z0) = fit_form(choice.form, &points).ok_or_else(|| {
             MovementError::Appliance(format!("the {arch:?} arch's brackets span no arch form"))
         })?;
-        let (left, right) = (
-            points.iter().max_by(|a, b| a.x.total_cmp(&b.x)),
-            points.iter().min_by(|a, b| a.x.total_cmp(&b.x)),
-        );
-        let z0 = match (left, right) {
-            (Some(l), Some(r)) => 0.5 * (l.z + r.z),
-            _ => 0.0,
-        };
         let y = points.iter().map(|p| p.y).sum::<f64>() / points.len() as f64;
-        let laid = lay(choice.form, &size, y, z0, &points);
+        // The wire coordinated to the setup's slots, then each bracket with a setup turned to
+        // the wire's run at its slot (first order) and levelled again, and the wire laid anew
+        // through the slots as they then stand.
+        let individual: Vec<bool> = setups.iter().map(Option::is_some).collect();
+        let laid = lay_coordinated(choice.form, &size, y, z0, &points, &individual);
+        for (k, b) in brackets.iter_mut().enumerate() {
+            let Some((r, _)) = setups[k] else {
+                continue;
+            };
+            let run = laid.nodes[laid.held[k]].q * DVec3::X;
+            b.bracket = self.placed_bracket(b.tooth, choice, Some(r.inverse() * run));
+        }
+        level(&mut brackets);
+        let points: Vec<DVec3> = (0..brackets.len())
+            .map(|k| slot_at(k, &brackets[k].bracket))
+            .collect();
+        let laid = lay_coordinated(choice.form, &size, y, z0, &points, &individual);
         for (b, &node) in brackets.iter_mut().zip(&laid.held) {
             b.node = node;
         }
@@ -224,12 +275,15 @@ impl Simulation {
             brackets,
             reactions: vec![Reaction::default(); n],
             stiffness: vec![[[0.0; 6]; 6]; n],
+            stop: (0..n).min_by(|&a, &b| points[a].x.abs().total_cmp(&points[b].x.abs())),
             last: Equilibrium {
                 iterations: 0,
                 residual: 0.0,
                 converged: true,
             },
             form: (size, y, z0),
+            aligned_slots: points,
+            individual,
             sequence: Vec::new(),
             history: vec![(day, choice)],
             solve_ns: 0,
@@ -300,15 +354,7 @@ impl Simulation {
             return;
         };
         let (size, y, z0) = w.form;
-        let points: Vec<DVec3> = w
-            .brackets
-            .iter()
-            .map(|b| {
-                let (rotation, translation) = world(&self.teeth[b.tooth]);
-                translation + rotation * b.bracket.centre
-            })
-            .collect();
-        let laid = lay(choice.form, &size, y, z0, &points);
+        let laid = lay_coordinated(choice.form, &size, y, z0, &w.aligned_slots, &w.individual);
         let day = self.elapsed_days;
         let w = &mut self.wires[k];
         for (b, &node) in w.brackets.iter_mut().zip(&laid.held) {
@@ -331,10 +377,17 @@ impl Simulation {
         let w = &self.wires[k];
         w.brackets
             .iter()
-            .map(|b| {
+            .enumerate()
+            .map(|(i, b)| {
                 let (rotation, translation) = world(&self.teeth[b.tooth]);
-                b.bracket
-                    .holder(b.node, rotation, translation, w.choice.size)
+                let mut h = b
+                    .bracket
+                    .holder(b.node, rotation, translation, w.choice.size);
+                if w.stop == Some(i) {
+                    h.play[0] = STOP_PLAY_MM;
+                    h.stiffness[0] = WALL_N_PER_MM;
+                }
+                h
             })
             .collect()
     }
@@ -342,25 +395,11 @@ impl Simulation {
     /// Brings wire `k` to equilibrium at the teeth's poses and records its reactions and
     /// stiffnesses.
     fn solve_wire(&mut self, k: usize, iterations: usize) {
-        let holders = self.holders(k);
         let clock = std::time::Instant::now();
+        let before = self.wires[k].rod.nodes.clone();
+        let holders = self.holders(k);
         let w = &mut self.wires[k];
-        let settings = Settings {
-            tolerance_n: STEP_TOLERANCE_N,
-            max_iterations: iterations,
-        };
-        let before = w.rod.nodes.clone();
-        w.last = w.rod.solve(&holders, &[], &settings);
-        if !w.last.converged && iterations < ENGAGE_ITERATIONS {
-            w.last = w.rod.solve(
-                &holders,
-                &[],
-                &Settings {
-                    max_iterations: ENGAGE_ITERATIONS,
-                    ..settings
-                },
-            );
-        }
+        w.last = equilibrium(&mut w.rod, &holders, iterations);
         if w.last.converged {
             w.reactions = w.rod.reactions(&holders);
             w.stiffness = w.rod.holder_stiffness(&holders);
@@ -415,7 +454,91 @@ impl Simulation {
 }
 
 /// A tooth's pose as a double-precision rotation and translation.
-fn world(t: &super::SimTooth) -> (glam::DQuat, DVec3) {
+impl Simulation {
+    /// The bracket of tooth `i` for `choice`: at its bracket point, turned by the prescription from
+    /// the tooth's own axes, its slot running along `along` (tooth frame) when given, else along
+    /// the tooth's mesiodistal axis.
+    fn placed_bracket(&self, i: usize, choice: WireChoice, along: Option<DVec3>) -> Bracket {
+        let t = &self.teeth[i];
+        let frame = &t.shape.geometry.frame;
+        let mesial = (frame.mesiodistal * t.fdi.local_x_mesial_sign()).as_dvec3();
+        let right = t.fdi.side() == Side::Right;
+        let buccal = frame.buccolingual.as_dvec3();
+        // A given run is kept exactly (a custom base turns the slot to it); the slot then faces
+        // the tooth's buccal direction as near as that allows.
+        let axes = match along {
+            Some(run) => {
+                let run = run.normalize();
+                ToothAxes {
+                    buccal: (buccal - run * buccal.dot(run)).normalize(),
+                    along: run,
+                    along_is_mesial: right,
+                }
+            }
+            None => ToothAxes {
+                buccal,
+                along: if right { mesial } else { -mesial },
+                along_is_mesial: right,
+            },
+        };
+        let point = t.pdl.as_ref().map_or(DVec3::ZERO, |p| p.bracket.as_dvec3());
+        Bracket::place(
+            t.fdi.arch(),
+            t.fdi.kind(),
+            point,
+            &axes,
+            choice.prescription,
+            choice.slot,
+        )
+    }
+}
+
+/// [`lay`] with the wire coordinated to pass through each of `points` marked `individual`: its
+/// offset from the form there is the point's (see [`lay`]).
+fn lay_coordinated(
+    form: ArchForm,
+    size: &ArchSize,
+    y: f64,
+    z0: f64,
+    points: &[DVec3],
+    individual: &[bool],
+) -> Laid {
+    let offsets: Vec<f64> = points
+        .iter()
+        .zip(individual)
+        .map(|(&p, &own)| {
+            if !own {
+                return 0.0;
+            }
+            let (q, tangent) = nearest_on_form(form, size, y, z0, p);
+            (DVec3::new(p.x, y, p.z) - q).dot(tangent.cross(DVec3::Y).normalize())
+        })
+        .collect();
+    lay(form, size, y, z0, points, &offsets)
+}
+
+/// The rod's equilibrium in `holders`: `iterations` Newton iterations, then
+/// [`ENGAGE_ITERATIONS`] if that was not enough.
+fn equilibrium(rod: &mut Rod, holders: &[Holder], iterations: usize) -> Equilibrium {
+    let settings = Settings {
+        tolerance_n: STEP_TOLERANCE_N,
+        max_iterations: iterations,
+    };
+    let first = rod.solve(holders, &[], &settings);
+    if first.converged || iterations >= ENGAGE_ITERATIONS {
+        return first;
+    }
+    rod.solve(
+        holders,
+        &[],
+        &Settings {
+            max_iterations: ENGAGE_ITERATIONS,
+            ..settings
+        },
+    )
+}
+
+fn world(t: &super::SimTooth) -> (DQuat, DVec3) {
     (
         t.pose.rotation.as_dquat().normalize(),
         t.pose.translation.as_dvec3(),

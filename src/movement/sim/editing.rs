@@ -162,6 +162,8 @@ impl Simulation {
             elapsed_days: 0.0,
             known: BTreeMap::new(),
             wires: Vec::new(),
+            contact_points: d.contact_points.clone(),
+            setup: d.setup.clone(),
         };
         if settings.model == MovementModel::Pdl {
             for t in &mut sim.teeth {

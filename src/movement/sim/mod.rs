@@ -77,7 +77,13 @@ use crate::{
         Body, Circle, CollisionShape, EndOverlap, Method, Motion, PairContact, query_knowing,
     },
     geometry::{Pose, mesh_separation},
-    teeth::{Arch, Fdi, Load, WireModel, arch::ArchCurve},
+    teeth::{
+        Arch, Fdi, Load, WireModel,
+        arch::{
+            ArchCurve,
+            irregularity::{Anterior, ContactPoints, irregularity_mm},
+        },
+    },
 };
 
 /// Rounds of cutting steps at contact times before blocked teeth are stopped outright.
@@ -260,6 +266,11 @@ pub struct Simulation {
     known: BTreeMap<(usize, usize), EndOverlap>,
     /// Archwires with their brackets, at most one per arch.
     pub wires: Vec<ArchWire>,
+    /// The anterior teeth's anatomic contact points (Little's irregularity index).
+    pub contact_points: ContactPoints,
+    /// Where teeth stand aligned, where known ([`crate::teeth::Dentition::setup`]): brackets are
+    /// bonded so that their slots are level there.
+    pub setup: BTreeMap<Fdi, crate::geometry::Pose>,
 }
 
 fn row(arch: Arch) -> usize {
@@ -273,6 +284,22 @@ impl Simulation {
     /// The index of a tooth.
     pub fn index_of(&self, fdi: Fdi) -> Option<usize> {
         self.teeth.iter().position(|t| t.fdi == fdi)
+    }
+
+    /// Little's irregularity index of `arch` where the teeth stand now (mm), or None when one of
+    /// its six anterior teeth is missing.
+    pub fn irregularity_mm(&self, arch: Arch) -> Option<f32> {
+        let anteriors: Vec<Anterior> = self
+            .teeth
+            .iter()
+            .filter(|t| t.fdi.arch() == arch && t.fdi.position() <= 3)
+            .map(|t| Anterior {
+                fdi: t.fdi,
+                geometry: &t.shape.geometry,
+                pose: t.pose,
+            })
+            .collect();
+        irregularity_mm(&anteriors, &self.contact_points, arch)
     }
 
     /// Forces received from blocked neighbours, acting in the coming step.

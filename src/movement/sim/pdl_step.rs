@@ -246,18 +246,21 @@ impl Simulation {
             (Some(WireModel::Round), _) | (None, _) => {}
         }
         let mut applied = wrench(force.as_dvec3(), bracket.as_dvec3(), couple, centre);
-        let mut damping = None;
+        let mut appliance_stiffness = None;
         if !wire.is_empty() {
             let (w, k) = super::archwire::about(&wire, centre);
             for (a, b) in applied.iter_mut().zip(w) {
                 *a += b;
             }
-            // Backward Euler against the wire's stiffness: (I + rate·C·K)⁻¹, K taken
-            // [`WIRE_COUPLING`] times over for the neighbours pulled along through the wire.
-            let rate = s.remodelling_per_day as f64 * s.step_days();
-            let m = crate::geometry::Mat6::identity()
-                .add_scaled(&compliance.mul(&k), rate * WIRE_COUPLING);
-            damping = m.inverse();
+            // Backward Euler against the wire's stiffness, K taken [`WIRE_COUPLING`] times over
+            // for the neighbours pulled along through the wire.
+            let mut stiff = k;
+            for row in stiff.0.iter_mut() {
+                for v in row.iter_mut() {
+                    *v *= WIRE_COUPLING;
+                }
+            }
+            appliance_stiffness = Some(stiff);
         }
         let area = parts.iter().map(|(_, _, p)| p.root_area_mm2).sum();
         Some(Unit {
@@ -268,7 +271,7 @@ impl Simulation {
                 area,
                 mean_spring: parts[0].2.mean_spring,
                 applied,
-                damping,
+                appliance_stiffness,
             },
         })
     }

@@ -42,6 +42,7 @@ use crate::geometry::{Aabb, Pose, mesh_separation};
 
 mod bisect;
 mod form;
+pub mod irregularity;
 mod occlusion;
 
 use bisect::{bisect_clamped, solve_increasing};
