@@ -122,13 +122,22 @@ pub fn rows(settings: &MovementSettings) -> Result<Vec<ValidationRow>, AnalysisE
             source: "98–151 gf across brands (Materials Research 2015), three-bracket test (ISO 15841), 0.016\" at 2 mm unloading",
         },
         ValidationRow {
+            name: "chain_force_fraction_day21",
+            tooth: 0,
+            mf: None,
+            value: crate::appliance::chain::remaining_fraction(21.0),
+            unit: "",
+            reference: Some([0.25, 0.65]),
+            source: "elastomeric chain at a fixed stretch: 37–75 % of its force lost by day 21 (Buchmann et al., Angle Orthod 2012;82:529–35)",
+        },
+        ValidationRow {
             name: "crowded_alignment_days",
             tooth: 0,
             mf: None,
             value: crowded_alignment_days(settings)?,
             unit: "days",
             reference: Some([60.0, 240.0]),
-            source: "the crowded case (Little's index 5.5 mm) under 0.014\" NiTi, 0.018\" NiTi from day 60, 0.019×0.025\" steel from day 120: lower index under 1 mm; alignment of moderate crowding takes months in clinical trials",
+            source: "the crowded case (Little's index 5.5 mm) under 0.014\" NiTi, 0.018\" NiTi from day 60, 0.019×0.025\" steel and a canine-to-canine chain from day 120: lower index under 1 mm; alignment of moderate crowding takes months in clinical trials",
         },
     ])
 }

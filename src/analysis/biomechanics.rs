@@ -16,6 +16,7 @@
 //! | `canine_retraction_mm_per_month_1n` | upper canine, first premolar extracted, 1 N distal on a rectangular wire: distal travel of its crown in 30 days | 0.71 mm (Monini et al. 2019, maxilla); accepted 0.6–0.8 |
 //! | `wire_three_point_stiffness_n_per_mm` | the archwire rod, 0.016" steel, centre-loaded on a 10 mm span | 48EI/L³ ± 10 % ([`super::appliance_rows`]) |
 //! | `niti_unloading_force_n` | the rod, 0.016" NiTi, three-bracket test (7 mm spans) unloading at 2 mm after 3.1 mm | 0.8–1.8 N (Materials Research 2015: 98–151 gf) |
+//! | `chain_force_fraction_day21` | the elastomeric chain's decay at a fixed stretch ([`crate::appliance::chain`]) | 0.25–0.65 (Buchmann 2012: 37–75 % lost) |
 //! | `crowded_alignment_days` | the `crowded` case with its wire sequence, as `simulate` runs it (continuous contacts): first day the lower Little index is under 1 mm | 60–240 days (clinical trials) |
 //!
 //! h is the root length below the crest. `reference` in the output is the accepted range: the

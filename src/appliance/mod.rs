@@ -9,6 +9,7 @@ pub mod archwire;
 pub mod banded;
 pub mod bench;
 pub mod bracket;
+pub mod chain;
 pub mod material;
 pub mod prescription;
 pub mod rod;

@@ -171,6 +171,15 @@ fn print_table(r: &SimulationReport) {
                 if b.engaged { "" } else { "  (passive)" }
             );
         }
+        for c in &a.chains {
+            match c.placed_day {
+                Some(day) => println!(
+                    "chain {}–{} placed on day {day:.0}: {:.2} N",
+                    c.from, c.to, c.tension_n
+                ),
+                None => println!("chain {}–{}: not placed yet", c.from, c.to),
+            }
+        }
         for (arch, series) in [
             ("upper", &a.irregularity_mm.upper),
             ("lower", &a.irregularity_mm.lower),

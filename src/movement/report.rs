@@ -158,6 +158,19 @@ pub struct BracketReport {
     pub engaged: bool,
 }
 
+/// An elastomeric chain at the end of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ChainReport {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Clinical day it was placed, if it was.
+    pub placed_day: Option<f64>,
+    /// Tension (N).
+    pub tension_n: f64,
+}
+
 /// The appliances at the end of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ApplianceReport {
@@ -167,6 +180,8 @@ pub struct ApplianceReport {
     pub wires: BTreeMap<&'static str, Vec<WireReport>>,
     /// Every bracket, upper arch first, each from the patient's right.
     pub brackets: Vec<BracketReport>,
+    /// Elastomeric chains at the end: ends and tension (N; 0 before it is placed or when slack).
+    pub chains: Vec<ChainReport>,
     /// Wire solves per step, all arches (µs: median and most), measured in this run.
     pub solve_us_per_step: [f64; 2],
     /// The median wire solve over the median collision step of this run.
@@ -311,6 +326,17 @@ fn appliance_report(
     let wire = WireReport::of(last.history.last().map_or(0.0, |h| h.0), &last.choice);
     let mut wires = BTreeMap::new();
     let mut brackets = Vec::new();
+    let chains = sim
+        .wires
+        .iter()
+        .flat_map(|w| &w.chains)
+        .map(|c| ChainReport {
+            from: c.from,
+            to: c.to,
+            placed_day: c.placed.map(|p| p.0),
+            tension_n: c.tension_n,
+        })
+        .collect();
     for arch in [Arch::Upper, Arch::Lower] {
         let Some(w) = sim.wires.iter().find(|w| w.arch == arch) else {
             continue;
@@ -343,6 +369,7 @@ fn appliance_report(
         wire,
         wires,
         brackets,
+        chains,
         solve_us_per_step: [solve, most],
         solve_over_collision: if collision > 0.0 {
             solve / collision

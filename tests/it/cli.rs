@@ -87,6 +87,11 @@ fn simulate_days_reports_the_wire_and_its_brackets() {
     assert_eq!(lower[3][0], 3.0);
     assert!((5.0..6.0).contains(&mm(&lower[0])), "{lower:?}");
     assert!(mm(&lower[3]) < mm(&lower[0]), "{lower:?}");
+    // The canine-to-canine chain waits for day 120.
+    assert_eq!(a["chains"][0]["from"], 43);
+    assert_eq!(a["chains"][0]["to"], 33);
+    assert!(a["chains"][0]["placed_day"].is_null());
+    assert_eq!(a["chains"][0]["tension_n"], 0.0);
     let upper = a["irregularity_mm"]["upper"].as_array().unwrap();
     assert!(upper.iter().all(|p| mm(p) < 0.01), "{upper:?}");
     // Days are refused where they mean nothing, and when not a number of days.
@@ -551,7 +556,7 @@ fn simulate_takes_either_model_and_validate_prints_its_rows() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "pdl");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 19);
+    assert_eq!(rows.len(), 20);
     assert!(
         rows.iter()
             .any(|r| r["name"] == "niti_unloading_force_n" && r["tooth"] == 0)
@@ -694,7 +699,7 @@ fn report_writes_every_file_its_page_refers_to() {
     }
     assert_eq!(
         v["biomechanics"]["rows"].as_array().map(|r| r.len()),
-        Some(19)
+        Some(20)
     );
     assert!(html.contains("The bite") && html.contains("biomechanics"));
     let fit = v["tree_fit"].as_array().unwrap();

@@ -25,7 +25,7 @@ use crate::{
     appliance::bracket::WALL_N_PER_MM,
     appliance::{
         ArchForm, ArchSize, Bracket, Equilibrium, Holder, Laid, Prescription, Reaction, Rod,
-        Settings, Slot, ToothAxes, WireMaterial, WireSize, fit_form, lay, nearest_on_form,
+        Settings, Slot, ToothAxes, WireMaterial, WireSize, chain, fit_form, lay, nearest_on_form,
     },
     geometry::{Mat6, Vec6},
     movement::{
@@ -90,6 +90,23 @@ pub struct Bonded {
     pub node: usize,
 }
 
+/// An elastomeric chain over an arch's brackets (see [`crate::appliance::chain`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chain {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Strain when placed.
+    pub stretch: f64,
+    /// Clinical day it is placed.
+    pub day: f64,
+    /// Once placed: the day it was and its relaxed length (mm).
+    pub placed: Option<(f64, f64)>,
+    /// Its tension in the last step (N).
+    pub tension_n: f64,
+}
+
 /// An arch's brackets and archwire.
 #[derive(Clone, Debug)]
 pub struct ArchWire {
@@ -119,6 +136,10 @@ pub struct ArchWire {
     /// Per bracket, whether the wire is coordinated to pass through its aligned slot (its tooth
     /// has a setup) or keeps to the form there.
     pub individual: Vec<bool>,
+    /// Elastomeric chains over the brackets.
+    pub chains: Vec<Chain>,
+    /// The chains' force on each bracket in the last step (N, world).
+    pub chain_forces: Vec<DVec3>,
     /// Wires still to come: the clinical day each is engaged, and the wire.
     pub sequence: Vec<(f64, WireChoice)>,
     /// The wires engaged so far: the day each was, and the wire.
@@ -275,6 +296,8 @@ impl Simulation {
             brackets,
             reactions: vec![Reaction::default(); n],
             stiffness: vec![[[0.0; 6]; 6]; n],
+            chains: Vec::new(),
+            chain_forces: vec![DVec3::ZERO; n],
             stop: (0..n).min_by(|&a, &b| points[a].x.abs().total_cmp(&points[b].x.abs())),
             last: Equilibrium {
                 iterations: 0,
@@ -340,8 +363,31 @@ impl Simulation {
                 })
                 .collect();
             sequence.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut chains = Vec::new();
+            for c in &w.chains {
+                for f in [c.from, c.to] {
+                    if !self
+                        .wires
+                        .last()
+                        .is_some_and(|last| last.brackets.iter().any(|b| b.fdi == f))
+                    {
+                        return Err(MovementError::Appliance(format!(
+                            "a chain ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
+                        )));
+                    }
+                }
+                chains.push(Chain {
+                    from: c.from,
+                    to: c.to,
+                    stretch: f64::from(c.stretch.0),
+                    day: f64::from(c.day.0),
+                    placed: None,
+                    tension_n: 0.0,
+                });
+            }
             if let Some(last) = self.wires.last_mut() {
                 last.sequence = sequence;
+                last.chains = chains;
             }
         }
         Ok(())
@@ -425,6 +471,44 @@ impl Simulation {
             } else {
                 self.solve_wire(k, STEP_ITERATIONS);
             }
+            self.pull_chains(k);
+        }
+    }
+
+    /// Places wire `k`'s chains that are due and sets each bracket's chain force for this step.
+    fn pull_chains(&mut self, k: usize) {
+        let slots: Vec<DVec3> = self.wires[k]
+            .brackets
+            .iter()
+            .map(|b| {
+                let (rotation, translation) = world(&self.teeth[b.tooth]);
+                translation + rotation * b.bracket.centre
+            })
+            .collect();
+        let today = self.elapsed_days;
+        let w = &mut self.wires[k];
+        w.chain_forces = vec![DVec3::ZERO; slots.len()];
+        for c in &mut w.chains {
+            let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
+            let [Some(a), Some(b)] = ends else {
+                continue;
+            };
+            let (lo, hi) = (a.min(b), a.max(b));
+            let points = &slots[lo..=hi];
+            let length = chain::length(points);
+            if c.placed.is_none() && c.day <= today + 1e-9 {
+                c.placed = Some((today, length / (1.0 + c.stretch)));
+            }
+            let Some((placed, relaxed)) = c.placed else {
+                continue;
+            };
+            c.tension_n = chain::tension_n(length, relaxed, today - placed);
+            for (f, add) in w.chain_forces[lo..=hi]
+                .iter_mut()
+                .zip(chain::forces(points, c.tension_n))
+            {
+                *f += add;
+            }
         }
     }
 
@@ -439,7 +523,9 @@ impl Simulation {
                 }
                 let (rotation, translation) = world(&self.teeth[i]);
                 let at = translation + rotation * b.bracket.centre;
-                out.push((at, w.reactions[k], Mat6(w.stiffness[k])));
+                let mut r = w.reactions[k];
+                r.force += w.chain_forces.get(k).copied().unwrap_or(DVec3::ZERO);
+                out.push((at, r, Mat6(w.stiffness[k])));
             }
         }
         out

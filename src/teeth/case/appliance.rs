@@ -187,6 +187,30 @@ pub struct CaseArchWire {
     /// Later wires, each engaged on its day (clinical days from the start), in order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sequence: Vec<WireChange>,
+    /// Elastomeric chains along the brackets, each from one bonded tooth to another.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chains: Vec<CaseChain>,
+}
+
+/// An elastomeric chain placed on `day` over the brackets from tooth `from` to tooth `to`,
+/// stretched by `stretch` (its strain when placed: 0.5 is half again its relaxed length).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseChain {
+    /// One end's tooth.
+    pub from: super::super::fdi::Fdi,
+    /// The other end's tooth.
+    pub to: super::super::fdi::Fdi,
+    /// Strain when placed (default 0.5).
+    #[serde(default = "half_stretch")]
+    pub stretch: NonNegative,
+    /// Clinical day it is placed (default 0).
+    #[serde(default)]
+    pub day: NonNegative,
+}
+
+fn half_stretch() -> NonNegative {
+    NonNegative(0.5)
 }
 
 /// A wire change: on `day`, the wire is taken out and this one engaged.
@@ -228,6 +252,19 @@ mod tests {
         .unwrap();
         assert_eq!((w.slot, w.form), (Slot::S018, ArchForm::Tapered));
         assert_eq!(w.sequence[0].day.0, 30.0);
+        let w = wire(
+            "(material: stainless_steel, size: Rect(0.019, 0.025), \
+             chains: [(from: 43, to: 33), (from: 44, to: 42, stretch: 0.8, day: 30)])",
+        )
+        .unwrap();
+        assert_eq!(
+            (
+                w.chains[0].stretch.0,
+                w.chains[0].day.0,
+                w.chains[1].stretch.0
+            ),
+            (0.5, 0.0, 0.8)
+        );
         let back: CaseArchWire = ron::from_str(&ron::to_string(&w).unwrap()).unwrap();
         assert_eq!(back, w);
     }
@@ -255,6 +292,14 @@ mod tests {
             (
                 "(material: ni_ti, size: Round(0.014), colour: red)",
                 "colour",
+            ),
+            (
+                "(material: ni_ti, size: Round(0.014), chains: [(from: 43, to: 39)])",
+                "unknown tooth",
+            ),
+            (
+                "(material: ni_ti, size: Round(0.014), chains: [(from: 43, to: 33, stretch: -1)])",
+                "negative",
             ),
         ] {
             let e = wire(src).unwrap_err();
