@@ -10,6 +10,7 @@ pub mod banded;
 pub mod bench;
 pub mod bracket;
 pub mod chain;
+pub mod coil;
 pub mod material;
 pub mod prescription;
 pub mod rod;

@@ -180,6 +180,15 @@ fn print_table(r: &SimulationReport) {
                 None => println!("chain {}–{}: not placed yet", c.from, c.to),
             }
         }
+        for c in &a.coils {
+            match c.placed_day {
+                Some(day) => println!(
+                    "{:?} coil {}–{} placed on day {day:.0}: {:.2} N",
+                    c.kind, c.from, c.to, c.force_n
+                ),
+                None => println!("{:?} coil {}–{}: not placed yet", c.kind, c.from, c.to),
+            }
+        }
         for (arch, series) in [
             ("upper", &a.irregularity_mm.upper),
             ("lower", &a.irregularity_mm.lower),

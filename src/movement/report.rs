@@ -171,6 +171,21 @@ pub struct ChainReport {
     pub tension_n: f64,
 }
 
+/// A coil spring at the end of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CoilReport {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// "closed" or "open".
+    pub kind: crate::appliance::coil::CoilKind,
+    /// Clinical day it was placed, if it was.
+    pub placed_day: Option<f64>,
+    /// Force (N).
+    pub force_n: f64,
+}
+
 /// The appliances at the end of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ApplianceReport {
@@ -182,6 +197,8 @@ pub struct ApplianceReport {
     pub brackets: Vec<BracketReport>,
     /// Elastomeric chains at the end: ends and tension (N; 0 before it is placed or when slack).
     pub chains: Vec<ChainReport>,
+    /// Coil springs at the end: ends, kind and force (N; 0 before placed or once spent).
+    pub coils: Vec<CoilReport>,
     /// Wire solves per step, all arches (µs: median and most), measured in this run.
     pub solve_us_per_step: [f64; 2],
     /// The median wire solve over the median collision step of this run.
@@ -326,6 +343,18 @@ fn appliance_report(
     let wire = WireReport::of(last.history.last().map_or(0.0, |h| h.0), &last.choice);
     let mut wires = BTreeMap::new();
     let mut brackets = Vec::new();
+    let coils = sim
+        .wires
+        .iter()
+        .flat_map(|w| &w.coils)
+        .map(|c| CoilReport {
+            from: c.from,
+            to: c.to,
+            kind: c.kind,
+            placed_day: c.placed.map(|p| p.0),
+            force_n: c.force_n,
+        })
+        .collect();
     let chains = sim
         .wires
         .iter()
@@ -370,6 +399,7 @@ fn appliance_report(
         wires,
         brackets,
         chains,
+        coils,
         solve_us_per_step: [solve, most],
         solve_over_collision: if collision > 0.0 {
             solve / collision

@@ -25,7 +25,8 @@ use crate::{
     appliance::bracket::WALL_N_PER_MM,
     appliance::{
         ArchForm, ArchSize, Bracket, Equilibrium, Holder, Laid, Prescription, Reaction, Rod,
-        Settings, Slot, ToothAxes, WireMaterial, WireSize, chain, fit_form, lay, nearest_on_form,
+        Settings, Slot, ToothAxes, WireMaterial, WireSize, chain, coil, fit_form, lay,
+        nearest_on_form,
     },
     geometry::{Mat6, Vec6},
     movement::{
@@ -107,6 +108,27 @@ pub struct Chain {
     pub tension_n: f64,
 }
 
+/// A NiTi coil spring between two brackets (see [`crate::appliance::coil`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coil {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Closed or open.
+    pub kind: coil::CoilKind,
+    /// Plateau force (N).
+    pub force: f64,
+    /// Activation when placed (mm).
+    pub activation: f64,
+    /// Clinical day it is placed.
+    pub day: f64,
+    /// Once placed: the day it was and its relaxed length (mm).
+    pub placed: Option<(f64, f64)>,
+    /// Its force in the last step (N).
+    pub force_n: f64,
+}
+
 /// An arch's brackets and archwire.
 #[derive(Clone, Debug)]
 pub struct ArchWire {
@@ -138,7 +160,9 @@ pub struct ArchWire {
     pub individual: Vec<bool>,
     /// Elastomeric chains over the brackets.
     pub chains: Vec<Chain>,
-    /// The chains' force on each bracket in the last step (N, world).
+    /// NiTi coil springs between brackets.
+    pub coils: Vec<Coil>,
+    /// The chains' and coils' force on each bracket in the last step (N, world).
     pub chain_forces: Vec<DVec3>,
     /// Wires still to come: the clinical day each is engaged, and the wire.
     pub sequence: Vec<(f64, WireChoice)>,
@@ -297,6 +321,7 @@ impl Simulation {
             reactions: vec![Reaction::default(); n],
             stiffness: vec![[[0.0; 6]; 6]; n],
             chains: Vec::new(),
+            coils: Vec::new(),
             chain_forces: vec![DVec3::ZERO; n],
             stop: (0..n).min_by(|&a, &b| points[a].x.abs().total_cmp(&points[b].x.abs())),
             last: Equilibrium {
@@ -385,9 +410,34 @@ impl Simulation {
                     tension_n: 0.0,
                 });
             }
+            let mut coils = Vec::new();
+            for c in &w.coils {
+                for f in [c.from, c.to] {
+                    if !self
+                        .wires
+                        .last()
+                        .is_some_and(|last| last.brackets.iter().any(|b| b.fdi == f))
+                    {
+                        return Err(MovementError::Appliance(format!(
+                            "a coil ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
+                        )));
+                    }
+                }
+                coils.push(Coil {
+                    from: c.from,
+                    to: c.to,
+                    kind: c.kind,
+                    force: f64::from(c.force_n.0),
+                    activation: f64::from(c.activation_mm.0),
+                    day: f64::from(c.day.0),
+                    placed: None,
+                    force_n: 0.0,
+                });
+            }
             if let Some(last) = self.wires.last_mut() {
                 last.sequence = sequence;
                 last.chains = chains;
+                last.coils = coils;
             }
         }
         Ok(())
@@ -475,7 +525,8 @@ impl Simulation {
         }
     }
 
-    /// Places wire `k`'s chains that are due and sets each bracket's chain force for this step.
+    /// Places wire `k`'s chains and coils that are due and sets each bracket's force from them for
+    /// this step.
     fn pull_chains(&mut self, k: usize) {
         let slots: Vec<DVec3> = self.wires[k]
             .brackets
@@ -509,6 +560,27 @@ impl Simulation {
             {
                 *f += add;
             }
+        }
+        for c in &mut w.coils {
+            let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
+            let [Some(a), Some(b)] = ends else {
+                continue;
+            };
+            let length = slots[a].distance(slots[b]);
+            if c.placed.is_none() && c.day <= today + 1e-9 {
+                let relaxed = match c.kind {
+                    coil::CoilKind::Closed => (length - c.activation).max(0.0),
+                    coil::CoilKind::Open => length + c.activation,
+                };
+                c.placed = Some((today, relaxed));
+            }
+            let Some((_, relaxed)) = c.placed else {
+                continue;
+            };
+            c.force_n = coil::force_n(c.kind, c.force, relaxed, length);
+            let [fa, fb] = coil::end_forces(c.kind, slots[a], slots[b], c.force_n);
+            w.chain_forces[a] += fa;
+            w.chain_forces[b] += fb;
         }
     }
 

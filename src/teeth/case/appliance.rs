@@ -190,6 +190,52 @@ pub struct CaseArchWire {
     /// Elastomeric chains along the brackets, each from one bonded tooth to another.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chains: Vec<CaseChain>,
+    /// NiTi coil springs, each hooked between two bonded teeth.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub coils: Vec<CaseCoil>,
+}
+
+/// A closed coil pulls its ends together; an open coil pushes them apart.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CoilKind {
+    /// Closed coil: space closure.
+    #[default]
+    Closed,
+    /// Open coil: space opening.
+    Open,
+}
+
+/// A NiTi coil spring placed on `day` between the brackets of `from` and `to`, activated by
+/// `activation_mm` (stretched for a closed coil, compressed for an open one), with plateau
+/// force `force_n`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseCoil {
+    /// One end's tooth.
+    pub from: super::super::fdi::Fdi,
+    /// The other end's tooth.
+    pub to: super::super::fdi::Fdi,
+    /// Closed (default) or open.
+    #[serde(default)]
+    pub kind: CoilKind,
+    /// Plateau force (N; default 1.5).
+    #[serde(default = "coil_force")]
+    pub force_n: NonNegative,
+    /// Activation when placed (mm; default 3).
+    #[serde(default = "coil_activation")]
+    pub activation_mm: NonNegative,
+    /// Clinical day it is placed (default 0).
+    #[serde(default)]
+    pub day: NonNegative,
+}
+
+fn coil_force() -> NonNegative {
+    NonNegative(1.5)
+}
+
+fn coil_activation() -> NonNegative {
+    NonNegative(3.0)
 }
 
 /// An elastomeric chain placed on `day` over the brackets from tooth `from` to tooth `to`,
@@ -300,6 +346,10 @@ mod tests {
             (
                 "(material: ni_ti, size: Round(0.014), chains: [(from: 43, to: 33, stretch: -1)])",
                 "negative",
+            ),
+            (
+                "(material: ni_ti, size: Round(0.014), coils: [(from: 13, to: 16, kind: spring)])",
+                "spring",
             ),
         ] {
             let e = wire(src).unwrap_err();
