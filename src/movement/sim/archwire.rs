@@ -390,17 +390,7 @@ impl Simulation {
             sequence.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut chains = Vec::new();
             for c in &w.chains {
-                for f in [c.from, c.to] {
-                    if !self
-                        .wires
-                        .last()
-                        .is_some_and(|last| last.brackets.iter().any(|b| b.fdi == f))
-                    {
-                        return Err(MovementError::Appliance(format!(
-                            "a chain ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
-                        )));
-                    }
-                }
+                self.bracketed(arch, "a chain", [c.from, c.to])?;
                 chains.push(Chain {
                     from: c.from,
                     to: c.to,
@@ -412,17 +402,7 @@ impl Simulation {
             }
             let mut coils = Vec::new();
             for c in &w.coils {
-                for f in [c.from, c.to] {
-                    if !self
-                        .wires
-                        .last()
-                        .is_some_and(|last| last.brackets.iter().any(|b| b.fdi == f))
-                    {
-                        return Err(MovementError::Appliance(format!(
-                            "a coil ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
-                        )));
-                    }
-                }
+                self.bracketed(arch, "a coil", [c.from, c.to])?;
                 coils.push(Coil {
                     from: c.from,
                     to: c.to,
@@ -523,6 +503,20 @@ impl Simulation {
             }
             self.pull_chains(k);
         }
+    }
+
+    /// An error naming the first of `ends` that carries no bracket of the wire last bonded on
+    /// `arch` (`what` ends on it).
+    fn bracketed(&self, arch: Arch, what: &str, ends: [Fdi; 2]) -> Result<(), MovementError> {
+        let last = self.wires.last();
+        for f in ends {
+            if !last.is_some_and(|w| w.brackets.iter().any(|b| b.fdi == f)) {
+                return Err(MovementError::Appliance(format!(
+                    "{what} ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Places wire `k`'s chains and coils that are due and sets each bracket's force from them for
