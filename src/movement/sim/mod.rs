@@ -56,6 +56,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 mod archwire;
+mod auxiliary;
 mod blocking;
 mod editing;
 mod impulse;
@@ -63,6 +64,7 @@ mod pdl_step;
 mod proposal;
 
 pub use archwire::{ArchWire, Bonded, STEP_ITERATIONS, STEP_TOLERANCE_N, WireChoice};
+pub use auxiliary::{Chain, Coil};
 pub use pdl_step::{MAX_SWEEPS, PUSH_BIAS_MM, PdlState, SOLVE_TOLERANCE_MM};
 
 use super::{

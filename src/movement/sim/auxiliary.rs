@@ -1,0 +1,162 @@
+//! Auxiliaries on an arch's wire: elastomeric chains along the brackets and NiTi coil springs
+//! between two of them, placed on their day, whose forces join the wire's at each bracket.
+
+use glam::DVec3;
+
+use super::{Simulation, archwire::world};
+use crate::{
+    appliance::{chain, coil},
+    movement::MovementError,
+    teeth::{Arch, Fdi, case::appliance::CaseArchWire},
+};
+
+/// An elastomeric chain over an arch's brackets (see [`crate::appliance::chain`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chain {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Strain when placed.
+    pub stretch: f64,
+    /// Clinical day it is placed.
+    pub day: f64,
+    /// Once placed: the day it was and its relaxed length (mm).
+    pub placed: Option<(f64, f64)>,
+    /// Its tension in the last step (N).
+    pub tension_n: f64,
+}
+
+/// A NiTi coil spring between two brackets (see [`crate::appliance::coil`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coil {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Closed or open.
+    pub kind: coil::CoilKind,
+    /// Plateau force (N).
+    pub force: f64,
+    /// Activation when placed (mm).
+    pub activation: f64,
+    /// Clinical day it is placed.
+    pub day: f64,
+    /// Once placed: the day it was and its relaxed length (mm).
+    pub placed: Option<(f64, f64)>,
+    /// Its force in the last step (N).
+    pub force_n: f64,
+}
+
+impl Simulation {
+    /// The chains and coils a case names on `arch`'s wire, just bonded.
+    ///
+    /// # Errors
+    /// [`MovementError::Appliance`] when one ends on a tooth without a bracket.
+    pub(super) fn auxiliaries(
+        &self,
+        arch: Arch,
+        w: &CaseArchWire,
+    ) -> Result<(Vec<Chain>, Vec<Coil>), MovementError> {
+        let mut chains = Vec::new();
+        for c in &w.chains {
+            self.bracketed(arch, "a chain", [c.from, c.to])?;
+            chains.push(Chain {
+                from: c.from,
+                to: c.to,
+                stretch: f64::from(c.stretch.0),
+                day: f64::from(c.day.0),
+                placed: None,
+                tension_n: 0.0,
+            });
+        }
+        let mut coils = Vec::new();
+        for c in &w.coils {
+            self.bracketed(arch, "a coil", [c.from, c.to])?;
+            coils.push(Coil {
+                from: c.from,
+                to: c.to,
+                kind: c.kind,
+                force: f64::from(c.force_n.0),
+                activation: f64::from(c.activation_mm.0),
+                day: f64::from(c.day.0),
+                placed: None,
+                force_n: 0.0,
+            });
+        }
+        Ok((chains, coils))
+    }
+
+    /// An error naming the first of `ends` that carries no bracket of the wire last bonded on
+    /// `arch` (`what` ends on it).
+    fn bracketed(&self, arch: Arch, what: &str, ends: [Fdi; 2]) -> Result<(), MovementError> {
+        let last = self.wires.last();
+        for f in ends {
+            if !last.is_some_and(|w| w.brackets.iter().any(|b| b.fdi == f)) {
+                return Err(MovementError::Appliance(format!(
+                    "{what} ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Places wire `k`'s chains and coils that are due and sets each bracket's force from them for
+    /// this step.
+    pub(super) fn pull_chains(&mut self, k: usize) {
+        let slots: Vec<DVec3> = self.wires[k]
+            .brackets
+            .iter()
+            .map(|b| {
+                let (rotation, translation) = world(&self.teeth[b.tooth]);
+                translation + rotation * b.bracket.centre
+            })
+            .collect();
+        let today = self.elapsed_days;
+        let w = &mut self.wires[k];
+        w.chain_forces = vec![DVec3::ZERO; slots.len()];
+        for c in &mut w.chains {
+            let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
+            let [Some(a), Some(b)] = ends else {
+                continue;
+            };
+            let (lo, hi) = (a.min(b), a.max(b));
+            let points = &slots[lo..=hi];
+            let length = chain::length(points);
+            if c.placed.is_none() && c.day <= today + 1e-9 {
+                c.placed = Some((today, length / (1.0 + c.stretch)));
+            }
+            let Some((placed, relaxed)) = c.placed else {
+                continue;
+            };
+            c.tension_n = chain::tension_n(length, relaxed, today - placed);
+            for (f, add) in w.chain_forces[lo..=hi]
+                .iter_mut()
+                .zip(chain::forces(points, c.tension_n))
+            {
+                *f += add;
+            }
+        }
+        for c in &mut w.coils {
+            let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
+            let [Some(a), Some(b)] = ends else {
+                continue;
+            };
+            let length = slots[a].distance(slots[b]);
+            if c.placed.is_none() && c.day <= today + 1e-9 {
+                let relaxed = match c.kind {
+                    coil::CoilKind::Closed => (length - c.activation).max(0.0),
+                    coil::CoilKind::Open => length + c.activation,
+                };
+                c.placed = Some((today, relaxed));
+            }
+            let Some((_, relaxed)) = c.placed else {
+                continue;
+            };
+            c.force_n = coil::force_n(c.kind, c.force, relaxed, length);
+            let [fa, fb] = coil::end_forces(c.kind, slots[a], slots[b], c.force_n);
+            w.chain_forces[a] += fa;
+            w.chain_forces[b] += fb;
+        }
+    }
+}
