@@ -195,11 +195,7 @@ impl Simulation {
         // are.
         let setups: Vec<Option<(DQuat, DVec3)>> = chosen
             .iter()
-            .map(|&i| {
-                self.setup
-                    .get(&self.teeth[i].fdi)
-                    .map(|p| (p.rotation.as_dquat().normalize(), p.translation.as_dvec3()))
-            })
+            .map(|&i| self.setup.get(&self.teeth[i].fdi).map(double))
             .collect();
         let mut brackets = Vec::new();
         for &i in &chosen {
@@ -557,10 +553,12 @@ fn equilibrium(rod: &mut Rod, holders: &[Holder], iterations: usize) -> Equilibr
 }
 
 pub(super) fn world(t: &super::SimTooth) -> (DQuat, DVec3) {
-    (
-        t.pose.rotation.as_dquat().normalize(),
-        t.pose.translation.as_dvec3(),
-    )
+    double(&t.pose)
+}
+
+/// A pose as a double-precision rotation and translation.
+fn double(p: &crate::geometry::Pose) -> (DQuat, DVec3) {
+    (p.rotation.as_dquat().normalize(), p.translation.as_dvec3())
 }
 
 /// The wrench about `centre` of the wire's loads, and their stiffness against the body's twist

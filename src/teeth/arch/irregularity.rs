@@ -99,10 +99,12 @@ impl ContactPoints {
                 bvh: &t.geometry.bvh,
             }
         }
-        let mut points = BTreeMap::new();
-        for t in teeth.iter().filter(|t| t.fdi.position() <= 3) {
-            points.insert(t.fdi, shape_contact_points(t.fdi, t.geometry));
-        }
+        // Each side from the aligned pair where there is one; the outline only for the rest.
+        let mut found: BTreeMap<Fdi, [Option<Vec3>; 2]> = teeth
+            .iter()
+            .filter(|t| t.fdi.position() <= 3)
+            .map(|t| (t.fdi, [None; 2]))
+            .collect();
         let find = |fdi: Fdi| teeth.iter().find(|t| t.fdi == fdi);
         for arch in [Arch::Upper, Arch::Lower] {
             for (a, b) in anterior_pairs(arch) {
@@ -119,12 +121,27 @@ impl ContactPoints {
                 }
                 for (t, other) in [(ta, b), (tb, a)] {
                     let local = t.pose.inverse().transform_point(mid);
-                    if let Some(p) = points.get_mut(&t.fdi) {
-                        p[facing(t.fdi, other)] = local;
+                    if let Some(p) = found.get_mut(&t.fdi) {
+                        p[facing(t.fdi, other)] = Some(local);
                     }
                 }
             }
         }
+        let points = found
+            .into_iter()
+            .filter_map(|(fdi, sides)| {
+                let t = find(fdi)?;
+                let shape = || shape_contact_points(fdi, t.geometry);
+                let [m, d] = match sides {
+                    [Some(m), Some(d)] => [m, d],
+                    [m, d] => {
+                        let s = shape();
+                        [m.unwrap_or(s[0]), d.unwrap_or(s[1])]
+                    }
+                };
+                Some((fdi, [m, d]))
+            })
+            .collect();
         Self(points)
     }
 }
