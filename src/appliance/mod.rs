@@ -3,11 +3,13 @@
 //! pushes back on each bracket with a force and a moment that fade as the teeth align.
 //!
 //! Engine-free (no ECS): the wire's cross-sections ([`section`]), alloys ([`material`]), the
-//! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses.
+//! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses; the
+//! alveolar envelope whose cortical plates hold the roots ([`bone`]).
 
 pub mod archwire;
 pub mod banded;
 pub mod bench;
+pub mod bone;
 pub mod bracket;
 pub mod chain;
 pub mod coil;
@@ -17,6 +19,7 @@ pub mod rod;
 pub mod section;
 
 pub use archwire::{ArchForm, ArchSize, Laid, fit_form, lay, nearest_on_form};
+pub use bone::{AlveolarEnvelope, Plate, PlateContact, RootedTooth};
 pub use bracket::{Bracket, Slot, ToothAxes, binding_angle_rad, torque_play_rad};
 pub use material::{Transformation, WireMaterial};
 pub use prescription::{BracketAngles, Prescription};

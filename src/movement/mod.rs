@@ -33,5 +33,6 @@ pub use report::{
 };
 pub use settings::{MovementModel, MovementSettings, Response};
 pub use sim::{
-    ArchWire, Bonded, Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome, WireChoice,
+    ArchWire, Bonded, CorticalContact, Found, Impact, SimGroup, SimTooth, Simulation, StepOutcome,
+    WireChoice,
 };

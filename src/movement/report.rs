@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::{
     MovementError,
     settings::MovementSettings,
-    sim::{Simulation, WireChoice},
+    sim::{CorticalContact, Simulation, WireChoice},
 };
 use crate::{
     appliance::ArchForm,
@@ -116,6 +116,8 @@ pub struct SimulationReport {
     /// Brackets and archwires, when the case bonds any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub appliance: Option<ApplianceReport>,
+    /// Every root that reached a cortical plate of the alveolar envelope (PDL model).
+    pub cortical_contacts: Vec<CorticalContact>,
 }
 
 /// A wire as the report names it.
@@ -208,6 +210,8 @@ pub struct ApplianceReport {
     /// Little's irregularity index of each arch over the run: `[day, mm]` at the start, at each
     /// whole day and at the end (empty for an arch missing an anterior tooth).
     pub irregularity_mm: Irregularity,
+    /// Every root that reached a cortical plate (as the run's `cortical_contacts`).
+    pub cortical_contacts: Vec<CorticalContact>,
 }
 
 /// Little's irregularity index of both arches over a run (see
@@ -408,6 +412,7 @@ fn appliance_report(
         },
         converged,
         irregularity_mm,
+        cortical_contacts: sim.cortical.clone(),
     })
 }
 
@@ -539,6 +544,7 @@ pub fn run_case_for(
         energy_lost_uj: sim.total_energy_lost_uj,
         teeth: tooth_travel(&sim),
         appliance: appliance_report(&sim, collision_steps, wire_steps, converged, irregularity),
+        cortical_contacts: sim.cortical.clone(),
     };
     Ok(CaseRun {
         report,

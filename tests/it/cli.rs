@@ -94,6 +94,9 @@ fn simulate_days_reports_the_wire_and_its_brackets() {
     assert_eq!(a["chains"][0]["tension_n"], 0.0);
     let upper = a["irregularity_mm"]["upper"].as_array().unwrap();
     assert!(upper.iter().all(|p| mm(p) < 0.01), "{upper:?}");
+    // No root reaches the bone's plates in three days of light NiTi.
+    assert_eq!(a["cortical_contacts"], serde_json::json!([]));
+    assert_eq!(v["cortical_contacts"], serde_json::json!([]));
     // Days are refused where they mean nothing, and when not a number of days.
     for bad in [
         vec![

@@ -2,6 +2,7 @@
 
 mod appliance;
 mod bite;
+mod bone;
 mod cli;
 mod collision;
 mod ecs;

@@ -154,6 +154,18 @@ pub struct PdlBody {
 }
 
 impl PdlBody {
+    /// A body that never moves (the bone): no compliance, no load.
+    pub fn fixed(centre: DVec3) -> Self {
+        Self {
+            centre,
+            compliance: Mat6::ZERO,
+            area: 1.0,
+            mean_spring: 1.0,
+            applied: [0.0; 6],
+            appliance_stiffness: None,
+        }
+    }
+
     /// Mean ligament pressure (kPa) under wrench `w` (see [`PdlStiffness::pressure_kpa`]).
     pub fn pressure_kpa(&self, w: &Vec6) -> f64 {
         PdlStiffness::pressure_kpa(&self.compliance, self.mean_spring, self.area, w)

@@ -28,6 +28,6 @@ pub use body::{PdlBody, blocked, constrained_compliance, engaged, rotated, shift
 pub use contact::{ContactRow, ContactSolve, SolveParams, solve_contacts};
 pub use settings::{CrestDepths, PdlSettings};
 pub use stiffness::{
-    PdlError, PdlStiffness, RootPoint, centre_of_elasticity, displacement_at, root_points,
-    stiffness_about, wrench,
+    PdlError, PdlStiffness, ROOT_SAMPLES, RootPoint, centre_of_elasticity, displacement_at,
+    root_points, root_samples, stiffness_about, wrench,
 };

@@ -82,6 +82,9 @@ pub struct PdlSettings {
     pub saturation_kpa: f32,
     /// Clinical time per simulation step (hours).
     pub step_hours: f32,
+    /// Whether the alveolar envelope's buccal and lingual cortical plates hold the roots
+    /// ([`crate::appliance::bone`]).
+    pub bone_plates: bool,
 }
 
 impl Default for PdlSettings {
@@ -100,6 +103,7 @@ impl Default for PdlSettings {
             remodelling_per_day: 18.0,
             saturation_kpa: 10.0,
             step_hours: 24.0,
+            bone_plates: true,
         }
     }
 }

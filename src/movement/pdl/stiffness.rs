@@ -177,6 +177,51 @@ pub struct PdlStiffness {
     pub root_area_mm2: f64,
     /// Mean spring stiffness per area, (k_n + 2 k_t)/3 (N/mm³), for the ligament pressure.
     pub mean_spring: f64,
+    /// Up to [`ROOT_SAMPLES`] points of the root below the crest, spread over it (tooth frame):
+    /// where the bone's plates are checked.
+    pub root_samples: Vec<Vec3>,
+}
+
+/// Most root points checked against the bone's plates per tooth.
+pub const ROOT_SAMPLES: usize = 48;
+
+/// Up to [`ROOT_SAMPLES`] points spread over the root of `geometry` below a crest `crest_mm`
+/// below its cervical line (tooth frame), as [`PdlStiffness::root_samples`].
+pub fn root_samples(geometry: &ToothGeometry, crest_mm: f32) -> Vec<Vec3> {
+    let f = &geometry.frame;
+    let points = root_points(&geometry.mesh, f.cervical_centre, f.long_axis, -crest_mm);
+    spread(
+        &points
+            .iter()
+            .map(|p| p.position.as_vec3())
+            .collect::<Vec<_>>(),
+        ROOT_SAMPLES,
+    )
+}
+
+/// Up to `n` of `points` spread over them: farthest-point sampling from the first.
+fn spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
+    let Some(&first) = points.first() else {
+        return Vec::new();
+    };
+    let mut out = vec![first];
+    let mut nearest: Vec<f32> = points.iter().map(|p| p.distance_squared(first)).collect();
+    while out.len() < n {
+        let (k, &d) = nearest
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .expect("points are not empty");
+        if d <= 0.0 {
+            break;
+        }
+        let p = points[k];
+        out.push(p);
+        for (q, m) in points.iter().zip(nearest.iter_mut()) {
+            *m = m.min(q.distance_squared(p));
+        }
+    }
+    out
 }
 
 impl PdlStiffness {
@@ -229,6 +274,13 @@ impl PdlStiffness {
             root_below_crest_mm: root_mm - crest_mm,
             root_area_mm2,
             mean_spring: (kn + 2.0 * kt) / 3.0,
+            root_samples: spread(
+                &points
+                    .iter()
+                    .map(|p| p.position.as_vec3())
+                    .collect::<Vec<_>>(),
+                ROOT_SAMPLES,
+            ),
         })
     }
 

@@ -164,6 +164,8 @@ impl Simulation {
             wires: Vec::new(),
             contact_points: d.contact_points.clone(),
             setup: d.setup.clone(),
+            bone: None,
+            cortical: Vec::new(),
         };
         if settings.model == MovementModel::Pdl {
             for t in &mut sim.teeth {
@@ -173,6 +175,22 @@ impl Simulation {
                     .and_then(|k| k.pdl.clone());
             }
             sim.prepare_pdl()?;
+            // The bone as the case stands, extraction sites included: their sockets are bone
+            // the neighbours may move into.
+            let extracted: Vec<(crate::teeth::Fdi, crate::geometry::Pose, Vec<Vec3>)> = d
+                .teeth
+                .iter()
+                .filter(|t| t.extracted)
+                .map(|t| {
+                    let crest = settings.pdl.crest_mm.of(t.geometry.kind);
+                    (
+                        t.fdi,
+                        t.pose,
+                        crate::movement::pdl::root_samples(&t.geometry, crest),
+                    )
+                })
+                .collect();
+            sim.make_bone(&extracted);
         }
         Ok(sim)
     }
@@ -356,6 +374,8 @@ impl Simulation {
         next.total_impacts = self.total_impacts;
         next.total_energy_lost_uj = self.total_energy_lost_uj;
         next.elapsed_days = self.elapsed_days;
+        next.bone = self.bone.clone();
+        next.cortical = self.cortical.clone();
         // The wires are laid again through the brackets left (as a wire is engaged afresh
         // after an extraction).
         for w in &self.wires {

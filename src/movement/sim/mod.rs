@@ -58,6 +58,7 @@ use serde::Serialize;
 mod archwire;
 mod auxiliary;
 mod blocking;
+mod bone;
 mod editing;
 mod impulse;
 mod pdl_step;
@@ -65,6 +66,7 @@ mod proposal;
 
 pub use archwire::{ArchWire, Bonded, STEP_ITERATIONS, STEP_TOLERANCE_N, WireChoice};
 pub use auxiliary::{Chain, Coil};
+pub use bone::{CorticalContact, PLATE_CONTACT_MM, RETURN_MM_PER_STEP};
 pub use pdl_step::{MAX_SWEEPS, PUSH_BIAS_MM, PdlState, SOLVE_TOLERANCE_MM};
 
 use super::{
@@ -273,6 +275,10 @@ pub struct Simulation {
     /// Where teeth stand aligned, where known ([`crate::teeth::Dentition::setup`]): brackets are
     /// bonded so that their slots are level there.
     pub setup: BTreeMap<Fdi, crate::geometry::Pose>,
+    /// The alveolar envelope whose cortical plates hold the roots (made at the first PDL step).
+    pub bone: Option<crate::appliance::AlveolarEnvelope>,
+    /// Every root that reached a cortical plate, in the order they did.
+    pub cortical: Vec<CorticalContact>,
 }
 
 fn row(arch: Arch) -> usize {

@@ -282,6 +282,7 @@ impl Simulation {
         // Only loaded teeth and teeth in contact can move: the others are not bodies this step.
         let loaded = |l: &crate::teeth::Load| l.force != Vec3::ZERO || l.torque != Vec3::ZERO;
         self.solve_wires();
+        self.ensure_bone();
         let mut needed: Vec<bool> = (0..n)
             .map(|i| loaded(&self.teeth[i].load) || self.is_bonded(i))
             .collect();
@@ -353,8 +354,15 @@ impl Simulation {
             });
             row_of.push(k);
         }
-        let (members, bodies): (Vec<Vec<usize>>, Vec<PdlBody>) =
+        let (members, mut bodies): (Vec<Vec<usize>>, Vec<PdlBody>) =
             units.into_iter().map(|u| (u.members, u.body)).unzip();
+        // The bone's plates: rows against one more body, which never moves.
+        let tooth_rows = rows.len();
+        let plates = self.plate_rows(&members, bodies.len());
+        if !plates.is_empty() {
+            bodies.push(PdlBody::fixed(DVec3::ZERO));
+            rows.extend(plates);
+        }
         let s = &self.settings.pdl;
         let params = SolveParams {
             rate: s.remodelling_per_day as f64 * s.step_days(),
@@ -363,15 +371,16 @@ impl Simulation {
             tolerance: SOLVE_TOLERANCE_MM,
             max_sweeps: MAX_SWEEPS,
         };
-        let warm: Vec<f64> = row_of
+        let mut warm: Vec<f64> = row_of
             .iter()
             .map(|&k| self.pdl.forces.get(k).copied().unwrap_or(0.0))
             .collect();
+        warm.resize(rows.len(), 0.0);
         let clock = std::time::Instant::now();
         let mut solve = solve_contacts(&bodies, &rows, Some(&warm), &params);
         // Touching teeth that move together open by the bias (see the module doc).
         let moving = |t: &Vec6| t.iter().any(|v| *v != 0.0);
-        let pushing: Vec<bool> = rows
+        let pushing: Vec<bool> = rows[..tooth_rows]
             .iter()
             .zip(&solve.forces)
             .map(|(r, f)| *f > 0.0 && (moving(&solve.twists[r.a]) || moving(&solve.twists[r.b])))

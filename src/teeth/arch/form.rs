@@ -47,6 +47,11 @@ impl ArchCurve {
         Self { table }
     }
 
+    /// Arc length from the midline to where the curve turns into its straight continuation.
+    pub fn half_length(&self) -> f32 {
+        self.table.last().map_or(0.0, |e| e.0)
+    }
+
     /// Point and unit tangent (direction of increasing arc length: from the patient's right to
     /// left) at signed arc length `s` (negative on the patient's right).
     pub fn at(&self, s: f32) -> (Vec2, Vec2) {
