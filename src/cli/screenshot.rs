@@ -44,6 +44,12 @@ pub struct ScreenshotArgs {
     /// Hide an arch (`upper` or `lower`), e.g. to see the other one's occlusal surface.
     #[arg(long, value_parser = ["upper", "lower"])]
     pub hide: Vec<String>,
+    /// Show the panel and the teeth window as the viewer does
+    #[arg(long)]
+    pub panel: bool,
+    /// Select a tooth (FDI number) in the teeth window, as a click would; repeat for several
+    #[arg(long, value_parser = clap::value_parser!(u8).range(11..=48))]
+    pub select: Vec<u8>,
     /// The PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
@@ -84,11 +90,16 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         overlays,
         ..Default::default()
     })
+    .insert_resource(PreSelect(args.select.clone()))
+    .add_systems(bevy::prelude::Update, pre_select)
     .add_plugins(ScreenshotPlugin {
         path: args.out.clone(),
         frames: args.frames,
         outcome: shared.clone(),
     });
+    if args.panel {
+        app.add_plugins(orthosim::ui::OrthoSimUiPlugin);
+    }
     app.run();
     let outcome = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
     match outcome.error {
@@ -102,9 +113,49 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
 }
 
 /// Without the viewer: says so.
+/// Teeth to select once they are spawned.
+#[cfg(feature = "viewer")]
+#[derive(bevy::prelude::Resource)]
+struct PreSelect(Vec<u8>);
+
+#[cfg(feature = "viewer")]
+fn pre_select(
+    mut wanted: bevy::prelude::ResMut<PreSelect>,
+    teeth: bevy::prelude::Query<(bevy::prelude::Entity, &orthosim::teeth::Tooth)>,
+    mut selection: bevy::prelude::ResMut<orthosim::occlusion_view::Selection>,
+) {
+    if wanted.0.is_empty() {
+        return;
+    }
+    let found: Vec<_> = wanted
+        .0
+        .iter()
+        .filter_map(|n| {
+            teeth
+                .iter()
+                .find(|(_, t)| t.id.number() == *n)
+                .map(|(e, _)| e)
+        })
+        .collect();
+    if found.len() == wanted.0.len() {
+        for e in found {
+            selection.pick(e, true);
+        }
+        wanted.0.clear();
+    }
+}
+
 #[cfg(not(feature = "viewer"))]
 pub fn run(args: ScreenshotArgs) -> Result<()> {
-    let _ = (args.frames, args.tree, args.algorithm, args.hide, args.out);
+    let _ = (
+        args.frames,
+        args.tree,
+        args.algorithm,
+        args.hide,
+        args.out,
+        args.panel,
+        args.select,
+    );
     orthosim::teeth::Case::resolve(&args.case)?;
     super::view::no_viewer()
 }

@@ -23,8 +23,8 @@ pub use error::MovementError;
 pub use model::ToothConstraint;
 #[cfg(feature = "ecs")]
 pub use plugin::{
-    MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad, SetLoad,
-    SetMomentToForce, SetWire, SimulationState, ToothImpact,
+    EditAppliance, MovementPlugin, MovementStatus, MovementSystems, SetExtracted, SetGroupLoad,
+    SetLoad, SetMomentToForce, SetWire, SimulationState, ToothImpact,
 };
 pub use report::{
     ApplianceReport, BracketReport, CaseRun, ChainReport, CoilReport, Irregularity, MOVED_MM,

@@ -21,7 +21,7 @@ use bevy::{
 use super::{
     MovementError,
     settings::MovementSettings,
-    sim::{Found, Impact, Simulation},
+    sim::{Found, Impact, Simulation, WireChoice},
 };
 use crate::{
     collision::{
@@ -29,7 +29,10 @@ use crate::{
         ToothMotion, motion::Motion,
     },
     simulation::{SimulationSystems, ensure_schedule},
-    teeth::{ActiveCase, Dentition, Extracted, Load, Tooth, Wire, WireModel},
+    teeth::{
+        ActiveCase, Arch, Dentition, Extracted, Fdi, Load, Tooth, Wire, WireModel,
+        case::appliance::CoilKind,
+    },
 };
 
 /// The movement plugin's systems, in the order they run; each sits in the stage of
@@ -141,6 +144,49 @@ pub struct SetExtracted {
     pub extracted: bool,
 }
 
+/// Change the appliances while the case runs (PDL model). A refused change is reported in
+/// [`SimulationState::notice`].
+#[derive(Message, Clone, Debug, PartialEq)]
+pub enum EditAppliance {
+    /// Bond `teeth` of `arch` (all but third molars when empty) and engage `choice`'s wire,
+    /// replacing the arch's wire.
+    Bond {
+        /// The arch.
+        arch: Arch,
+        /// The wire and brackets.
+        choice: WireChoice,
+        /// The teeth to bond.
+        teeth: Vec<Fdi>,
+    },
+    /// Take the arch's wire and brackets off.
+    Debond {
+        /// The arch.
+        arch: Arch,
+    },
+    /// An elastomeric chain between two bonded teeth, stretched by `stretch`.
+    Chain {
+        /// One end.
+        from: Fdi,
+        /// The other end.
+        to: Fdi,
+        /// Strain when placed.
+        stretch: f64,
+    },
+    /// A NiTi coil spring between two bonded teeth.
+    Coil {
+        /// One end.
+        from: Fdi,
+        /// The other end.
+        to: Fdi,
+        /// Closed or open.
+        kind: CoilKind,
+        /// Plateau force (N).
+        force_n: f64,
+        /// Activation (mm).
+        activation_mm: f64,
+    },
+}
+
 /// An impact of the `impulse` response.
 #[derive(Message, Clone, Debug, PartialEq, Deref)]
 pub struct ToothImpact(pub Impact);
@@ -181,6 +227,7 @@ impl Plugin for MovementPlugin {
             .add_message::<SetWire>()
             .add_message::<SetMomentToForce>()
             .add_message::<SetExtracted>()
+            .add_message::<EditAppliance>()
             .add_message::<ToothImpact>()
             .configure_sets(
                 self.schedule,
@@ -201,7 +248,7 @@ impl Plugin for MovementPlugin {
                 self.schedule,
                 (
                     start_simulation.in_set(MovementSystems::Start),
-                    (edit_teeth, apply_loads)
+                    (edit_teeth, apply_loads, edit_appliances)
                         .chain()
                         .in_set(MovementSystems::Loads),
                     propose.in_set(MovementSystems::Propose),
@@ -403,6 +450,42 @@ fn apply_loads(
             && let Err(e) = sim.set_load(i, *load)
         {
             refuse(e);
+        }
+    }
+}
+
+fn edit_appliances(mut state: ResMut<SimulationState>, mut messages: MessageReader<EditAppliance>) {
+    let state = &mut *state;
+    let Some(sim) = state.sim.as_mut() else {
+        messages.clear();
+        return;
+    };
+    for m in messages.read() {
+        let done = match m {
+            EditAppliance::Bond {
+                arch,
+                choice,
+                teeth,
+            } => sim.bond(*arch, *choice, teeth),
+            EditAppliance::Debond { arch } => {
+                sim.debond(*arch);
+                Ok(())
+            }
+            EditAppliance::Chain { from, to, stretch } => sim.add_chain(*from, *to, *stretch),
+            EditAppliance::Coil {
+                from,
+                to,
+                kind,
+                force_n,
+                activation_mm,
+            } => sim.add_coil(*from, *to, *kind, *force_n, *activation_mm),
+        };
+        match done {
+            Ok(()) => state.notice = None,
+            Err(e) => {
+                warn!("{e}");
+                state.notice = Some(e.to_string());
+            }
         }
     }
 }

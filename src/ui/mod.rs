@@ -26,6 +26,7 @@
 //! The camera ignores the mouse while the pointer is over the panel: the plugin makes the view's
 //! [`CameraInputSystems`] run only when egui does not want the pointer.
 
+mod appliance;
 mod bite;
 mod case;
 mod collision;
@@ -42,7 +43,7 @@ use bevy_egui::{EguiContexts, EguiPlugin, EguiPrimaryContextPass, egui, input::E
 
 use crate::{
     collision::{CollisionSettings, Contacts},
-    movement::{MovementSettings, MovementStatus, SimulationState},
+    movement::{MovementModel, MovementSettings, MovementStatus, SimulationState},
     occlusion_view::{CameraInputSystems, Overlays},
     simulation::SimulationSchedule,
     sphere_tree::{SphereTreeProgress, SphereTreeSettings, TreeMethod},
@@ -62,6 +63,7 @@ impl Plugin for OrthoSimUiPlugin {
         }
         app.init_resource::<PanelState>()
             .init_resource::<teeth::LoadEditor>()
+            .init_resource::<appliance::ApplianceEditor>()
             .init_resource::<bite::BiteView>()
             .configure_sets(Update, CameraInputSystems.run_if(pointer_free))
             .add_observer(teeth::click_tooth)
@@ -69,7 +71,25 @@ impl Plugin for OrthoSimUiPlugin {
                 EguiPrimaryContextPass,
                 (panel, teeth::loads_window, bite::bite_window),
             )
-            .add_systems(Update, single_step);
+            .add_systems(Update, (single_step, clinical_pace));
+    }
+}
+
+/// Clinical days the clock runs per second at speed 1 under the PDL model: about a week, a pace a
+/// person can follow (the fixed step's default 64 Hz would be two months a second).
+pub const DAYS_PER_SECOND: f64 = 7.0;
+
+/// Sets the fixed step's rate so that, under the PDL model, speed 1 runs [`DAYS_PER_SECOND`]
+/// clinical days a second whatever a step's length; the paper's model keeps Bevy's default rate.
+fn clinical_pace(settings: Res<MovementSettings>, mut fixed: ResMut<Time<Fixed>>) {
+    let step = match settings.model {
+        MovementModel::Pdl => {
+            std::time::Duration::from_secs_f64(settings.pdl.step_days() / DAYS_PER_SECOND)
+        }
+        MovementModel::Paper => Time::<Fixed>::default().timestep(),
+    };
+    if fixed.timestep() != step && step > std::time::Duration::ZERO {
+        fixed.set_timestep(step);
     }
 }
 

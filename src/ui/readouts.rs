@@ -82,11 +82,13 @@ pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, s: Sources<'_, 
         });
 }
 
-/// The gaps (mm) of the labelled pairs, with the 1 mm line.
-/// Elapsed treatment time as a clinician reads it: days, or months past two months.
+/// Elapsed treatment time as a clinician reads it: days, then weeks past two weeks, then months
+/// past two months.
 fn elapsed(days: f64) -> String {
     if days >= 61.0 {
-        format!("{:.0} days ({:.1} months)", days, days / 30.44)
+        format!("{:.1} months ({days:.0} days)", days / 30.44)
+    } else if days >= 14.0 {
+        format!("{:.1} weeks ({days:.0} days)", days / 7.0)
     } else if days >= 1.0 {
         format!("{days:.0} days")
     } else {
@@ -94,6 +96,7 @@ fn elapsed(days: f64) -> String {
     }
 }
 
+/// The gaps (mm) of the labelled pairs, with the 1 mm line.
 fn gap_plot(ui: &mut egui::Ui, gaps: &[(String, f32)]) {
     let points: Vec<[f64; 2]> = gaps
         .iter()

@@ -27,10 +27,14 @@ pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, time: &mut Time
     let mut speed = state.speed;
     if ui
         .add(
-            egui::Slider::new(&mut speed, 0.1..=8.0)
+            egui::Slider::new(&mut speed, 0.1..=30.0)
                 .text("speed ×")
                 .logarithmic(true),
         )
+        .on_hover_text(format!(
+            "Clock speed. Under the ligament model, 1× runs about {:.0} clinical days a second; 30× about seven months a second.",
+            super::DAYS_PER_SECOND
+        ))
         .changed()
     {
         state.speed = speed;

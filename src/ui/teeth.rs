@@ -1,12 +1,14 @@
 //! The **Teeth and loads** window: the selection (click a tooth, shift-click for a group, or the
 //! FDI chart) and what is done to it: loads with presets along each tooth's own axes, wires,
-//! extraction and restoration.
+//! extraction and restoration, and the appliances (see [`super::appliance`]); each selected
+//! tooth's bracket force and whether its root is at a cortical plate.
 
 use bevy::{ecs::system::SystemParam, prelude::*};
 use bevy_egui::{EguiContexts, egui};
 
+use super::appliance::{self, ApplianceEditor};
 use crate::{
-    movement::{SetExtracted, SetLoad, SetMomentToForce, SetWire, SimulationState},
+    movement::{EditAppliance, SetExtracted, SetLoad, SetMomentToForce, SetWire, SimulationState},
     occlusion_view::Selection,
     teeth::{Extracted, Load, Tooth, Wire, WireModel},
 };
@@ -94,12 +96,14 @@ pub(super) struct ToothEdits<'w> {
     wire: MessageWriter<'w, SetWire>,
     mf: MessageWriter<'w, SetMomentToForce>,
     extracted: MessageWriter<'w, SetExtracted>,
+    appliance: MessageWriter<'w, EditAppliance>,
 }
 
 /// The window: chart, load presets, wires, extraction, and what the selected teeth carry.
 pub(super) fn loads_window(
     mut contexts: EguiContexts,
     mut editor: ResMut<LoadEditor>,
+    mut appliances: ResMut<ApplianceEditor>,
     mut selection: ResMut<Selection>,
     teeth: WindowTeeth,
     sim: Res<SimulationState>,
@@ -116,6 +120,12 @@ pub(super) fn loads_window(
             loads(ui, &editor, &selection, &teeth, &mut edits.load);
             moment_to_force(ui, &mut editor, &selection, &mut edits.mf);
             wires_and_extraction(ui, &selection, &mut edits);
+            let numbers: Vec<crate::teeth::Fdi> = selection
+                .0
+                .iter()
+                .filter_map(|e| teeth.get(*e).ok().map(|t| t.1.id))
+                .collect();
+            appliance::section(ui, &mut appliances, &numbers, &sim, &mut edits.appliance);
             if let Some(notice) = &sim.notice {
                 ui.colored_label(egui::Color32::LIGHT_RED, notice);
             }
@@ -322,6 +332,29 @@ fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth, sim: 
                 None => "at rest".to_owned(),
             };
             ui.label(format!("    {rotation}"));
+            if let Some(r) = s.wires.iter().find_map(|w| w.reaction_of(i)) {
+                let (f, m) = (r.force, r.moment);
+                ui.label(format!(
+                    "    bracket: {:.2} N ({:+.2}, {:+.2}, {:+.2}), {:.1} N·mm",
+                    f.length(),
+                    f.x,
+                    f.y,
+                    f.z,
+                    m.length()
+                ))
+                .on_hover_text("the wire's force on the bracket (world x left, y up, z forward) and its moment");
+            }
+            if let Some(c) = s
+                .cortical
+                .iter()
+                .rev()
+                .find(|c| c.fdi == t.fdi && c.until_day >= s.elapsed_days - 1.0)
+            {
+                ui.label(
+                    format!("    root at the {:?} plate since day {:.0}", c.plate, c.day)
+                        .to_lowercase(),
+                );
+            }
         }
     }
 }

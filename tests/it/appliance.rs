@@ -264,3 +264,45 @@ fn a_closed_coil_closes_an_extraction_space_along_the_wire() {
     );
     assert!(max_penetration(&sim) < 0.05, "{}", max_penetration(&sim));
 }
+
+#[test]
+fn the_panel_can_bond_chain_coil_and_debond_an_arch() {
+    let mut sim = normal();
+    sim.bond(Arch::Lower, WireChoice::default(), &[]).unwrap();
+    sim.add_chain(fdi(43), fdi(33), 0.5).unwrap();
+    sim.add_coil(
+        fdi(44),
+        fdi(46),
+        orthosim::teeth::case::appliance::CoilKind::Open,
+        1.5,
+        3.0,
+    )
+    .unwrap();
+    // Refused: ends on two arches, an end without a bracket, a stretch or force out of range.
+    for bad in [
+        sim.add_chain(fdi(43), fdi(13), 0.5),
+        sim.add_chain(fdi(43), fdi(48), 0.5),
+        sim.add_chain(fdi(43), fdi(33), f64::NAN),
+        sim.add_coil(fdi(44), fdi(46), Default::default(), 9.0, 3.0),
+    ] {
+        let e = bad.unwrap_err().to_string();
+        assert!(e.contains("chain") || e.contains("coil"), "{e}");
+    }
+    assert_eq!(sim.wires[0].chains.len(), 1);
+    assert_eq!(sim.wires[0].coils.len(), 1);
+    // Placed today, they pull from the next step.
+    sim.step();
+    assert!(
+        sim.wires[0].chains[0].tension_n > 0.5,
+        "{:?}",
+        sim.wires[0].chains
+    );
+    assert!(
+        sim.wires[0].coils[0].force_n > 0.5,
+        "{:?}",
+        sim.wires[0].coils
+    );
+    sim.debond(Arch::Lower);
+    assert!(sim.wires.is_empty());
+    assert!(sim.add_chain(fdi(43), fdi(33), 0.5).is_err());
+}

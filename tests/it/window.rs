@@ -142,3 +142,34 @@ fn roots_hide_and_bounding_circles_show() {
         green(&solid)
     );
 }
+
+#[test]
+fn the_panel_shows_over_the_view_with_a_selected_tooth() {
+    if !have_xvfb() {
+        return;
+    }
+    let region = |buf: &[u8], channels: usize, x0: usize, x1: usize| -> usize {
+        // Distinct colours in columns x0..x1 of the 1280-wide image: the panel's text and
+        // widgets make many, the dark background few.
+        let mut seen = std::collections::HashSet::new();
+        for row in buf.chunks(1280 * channels) {
+            for px in row[x0 * channels..x1 * channels].chunks(channels) {
+                seen.insert(px.to_vec());
+            }
+        }
+        seen.len()
+    };
+    let (_, _, channels, plain) = shoot("nopanel", &["--case", "crowded"]);
+    let (_, _, _, panel) = shoot("panel", &["--case", "crowded", "--panel", "--select", "42"]);
+    // The panel (left) and the teeth window (right) are drawn over the view.
+    let (left, right) = (
+        region(&panel, channels, 0, 300),
+        region(&panel, channels, 1000, 1280),
+    );
+    let (left0, right0) = (
+        region(&plain, channels, 0, 300),
+        region(&plain, channels, 1000, 1280),
+    );
+    assert!(left > 4 * left0.max(10), "left {left} from {left0}");
+    assert!(right > 4 * right0.max(10), "right {right} from {right0}");
+}

@@ -90,14 +90,92 @@ impl Simulation {
     /// An error naming the first of `ends` that carries no bracket of the wire last bonded on
     /// `arch` (`what` ends on it).
     fn bracketed(&self, arch: Arch, what: &str, ends: [Fdi; 2]) -> Result<(), MovementError> {
-        let last = self.wires.last();
+        let wire = self.wires.iter().rev().find(|w| w.arch == arch);
         for f in ends {
-            if !last.is_some_and(|w| w.brackets.iter().any(|b| b.fdi == f)) {
+            if !wire.is_some_and(|w| w.brackets.iter().any(|b| b.fdi == f)) {
                 return Err(MovementError::Appliance(format!(
                     "{what} ends on tooth {f}, which carries no bracket of the {arch:?} arch's wire"
                 )));
             }
         }
+        Ok(())
+    }
+
+    /// The index of the wire both `ends` are bonded to.
+    fn wire_between(&self, what: &str, ends: [Fdi; 2]) -> Result<usize, MovementError> {
+        let arch = ends[0].arch();
+        if ends[1].arch() != arch || ends[0] == ends[1] {
+            return Err(MovementError::Appliance(format!(
+                "{what} needs two teeth of one arch, not {} and {}",
+                ends[0], ends[1]
+            )));
+        }
+        self.bracketed(arch, what, ends)?;
+        self.wires
+            .iter()
+            .rposition(|w| w.arch == arch)
+            .ok_or_else(|| {
+                MovementError::Appliance(format!("{what}: no wire on the {arch:?} arch"))
+            })
+    }
+
+    /// Places an elastomeric chain from `from` to `to` over the brackets between them, today,
+    /// stretched by `stretch` (strain, 0–1.5).
+    ///
+    /// # Errors
+    /// [`MovementError::Appliance`] when an end carries no bracket, the ends are not of one arch,
+    /// or the stretch is out of range.
+    pub fn add_chain(&mut self, from: Fdi, to: Fdi, stretch: f64) -> Result<(), MovementError> {
+        let k = self.wire_between("a chain", [from, to])?;
+        if !(stretch.is_finite() && (0.0..=1.5).contains(&stretch)) {
+            return Err(MovementError::Appliance(format!(
+                "a chain's stretch must be 0–1.5, not {stretch}"
+            )));
+        }
+        let day = self.elapsed_days;
+        self.wires[k].chains.push(Chain {
+            from,
+            to,
+            stretch,
+            day,
+            placed: None,
+            tension_n: 0.0,
+        });
+        Ok(())
+    }
+
+    /// Places a NiTi coil spring between the brackets of `from` and `to`, today, with a plateau
+    /// of `force` N, activated by `activation` mm.
+    ///
+    /// # Errors
+    /// As [`Simulation::add_chain`], and for a force outside 0–5 N or an activation outside
+    /// 0–10 mm.
+    pub fn add_coil(
+        &mut self,
+        from: Fdi,
+        to: Fdi,
+        kind: coil::CoilKind,
+        force: f64,
+        activation: f64,
+    ) -> Result<(), MovementError> {
+        let k = self.wire_between("a coil", [from, to])?;
+        let bad = |v: f64, hi: f64| !(v.is_finite() && (0.0..=hi).contains(&v));
+        if bad(force, 5.0) || bad(activation, 10.0) {
+            return Err(MovementError::Appliance(format!(
+                "a coil needs a force of 0–5 N and an activation of 0–10 mm, not {force} N and {activation} mm"
+            )));
+        }
+        let day = self.elapsed_days;
+        self.wires[k].coils.push(Coil {
+            from,
+            to,
+            kind,
+            force,
+            activation,
+            day,
+            placed: None,
+            force_n: 0.0,
+        });
         Ok(())
     }
 
