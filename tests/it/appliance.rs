@@ -306,3 +306,49 @@ fn the_panel_can_bond_chain_coil_and_debond_an_arch() {
     assert!(sim.wires.is_empty());
     assert!(sim.add_chain(fdi(43), fdi(33), 0.5).is_err());
 }
+
+#[test]
+fn case1_chain_closes_the_extraction_spaces_by_sliding_on_the_wire() {
+    use orthosim::movement::{RunLimit, run_case_for};
+    let run = run_case_for(
+        "case1-chain",
+        Method::Exact,
+        MovementSettings::default(),
+        TreeSettings::with_method(TreeMethod::Octree),
+        None,
+        RunLimit {
+            max_steps: 100_000,
+            max_days: Some(240.0),
+        },
+        |_| {},
+    )
+    .unwrap();
+    let r = &run.report;
+    let sim = &run.simulation;
+    assert!(r.max_penetration_mm <= 0.01, "{}", r.max_penetration_mm);
+    let a = r.appliance.as_ref().unwrap();
+    assert!(a.converged);
+    assert_eq!(a.chains.len(), 6);
+    // Each first molar is drawn mesially along its arch by millimetres.
+    for m in [16, 26, 36, 46] {
+        let i = sim.index_of(fdi(m)).unwrap();
+        let t = &sim.teeth[i];
+        let mesial = t
+            .initial
+            .transform_vector(glam::Vec3::X * t.fdi.local_x_mesial_sign());
+        let moved = (t.crown_centre()
+            - t.initial
+                .transform_point(t.shape.geometry.frame.crown_centre))
+        .dot(mesial);
+        assert!(moved > 1.5, "{m} moved {moved} mm mesially");
+    }
+    // The extraction spaces (about 7 mm) are mostly closed.
+    for (a, b) in [(15, 13), (23, 25), (45, 43), (33, 35)] {
+        let d = r
+            .distances
+            .iter()
+            .find(|d| (d.a, d.b) == (fdi(a), fdi(b)) || (d.a, d.b) == (fdi(b), fdi(a)))
+            .unwrap();
+        assert!(d.surface_gap_mm < 3.0, "{a}-{b}: {} mm", d.surface_gap_mm);
+    }
+}

@@ -44,7 +44,14 @@ fn cases_lists_the_builtin_cases() {
         .collect();
     assert_eq!(
         names,
-        ["normal", "case1", "case2", "case3", "crowded"],
+        [
+            "normal",
+            "case1",
+            "case2",
+            "case3",
+            "crowded",
+            "case1-chain"
+        ],
         "{text}"
     );
 }

@@ -21,6 +21,8 @@ pub struct Chain {
     pub stretch: f64,
     /// Clinical day it is placed.
     pub day: f64,
+    /// Replaced by a fresh chain at the same stretch every this many days (None: never).
+    pub renew_days: Option<f64>,
     /// Once placed: the day it was and its relaxed length (mm).
     pub placed: Option<(f64, f64)>,
     /// Its tension in the last step (N).
@@ -66,6 +68,7 @@ impl Simulation {
                 to: c.to,
                 stretch: f64::from(c.stretch.0),
                 day: f64::from(c.day.0),
+                renew_days: c.renew_days.map(|d| f64::from(d.0)).filter(|d| *d > 0.0),
                 placed: None,
                 tension_n: 0.0,
             });
@@ -138,6 +141,7 @@ impl Simulation {
             to,
             stretch,
             day,
+            renew_days: None,
             placed: None,
             tension_n: 0.0,
         });
@@ -201,7 +205,12 @@ impl Simulation {
             let (lo, hi) = (a.min(b), a.max(b));
             let points = &slots[lo..=hi];
             let length = chain::length(points);
-            if c.placed.is_none() && c.day <= today + 1e-9 {
+            let due = match (c.placed, c.renew_days) {
+                (None, _) => c.day <= today + 1e-9,
+                (Some((placed, _)), Some(every)) => today - placed >= every - 1e-9,
+                (Some(_), None) => false,
+            };
+            if due {
                 c.placed = Some((today, length / (1.0 + c.stretch)));
             }
             let Some((placed, relaxed)) = c.placed else {

@@ -253,6 +253,10 @@ pub struct CaseChain {
     /// Clinical day it is placed (default 0).
     #[serde(default)]
     pub day: NonNegative,
+    /// Replaced by a fresh chain at the same stretch every this many days, as at each clinical
+    /// visit (default: never).
+    #[serde(default)]
+    pub renew_days: Option<NonNegative>,
 }
 
 fn half_stretch() -> NonNegative {

@@ -21,12 +21,16 @@ pub use values::{Finite, NonNegative, ToothList, ToothMap};
 use super::{fdi::Fdi, import::ImportError, shape::ToothResolution};
 
 /// The built-in cases: name and RON source (embedded in the binary).
-pub const BUILTIN_CASES: [(&str, &str); 5] = [
+pub const BUILTIN_CASES: [(&str, &str); 6] = [
     ("normal", include_str!("../../../assets/cases/normal.ron")),
     ("case1", include_str!("../../../assets/cases/case1.ron")),
     ("case2", include_str!("../../../assets/cases/case2.ron")),
     ("case3", include_str!("../../../assets/cases/case3.ron")),
     ("crowded", include_str!("../../../assets/cases/crowded.ron")),
+    (
+        "case1-chain",
+        include_str!("../../../assets/cases/case1-chain.ron"),
+    ),
 ];
 
 /// Longest case name (characters): the name becomes a file name when a case is exported.
@@ -95,7 +99,7 @@ pub enum CaseError {
     },
     /// The name is neither a built-in case nor an existing file.
     #[error(
-        "unknown case '{0}': not a built-in case (normal, case1, case2, case3) nor a .ron file"
+        "unknown case '{0}': not a built-in case (normal, case1, case2, case3, crowded, case1-chain) nor a .ron file"
     )]
     Unknown(String),
 }
