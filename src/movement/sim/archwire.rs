@@ -128,6 +128,8 @@ pub struct ArchWire {
     pub coils: Vec<Coil>,
     /// The chains' and coils' force on each bracket in the last step (N, world).
     pub chain_forces: Vec<DVec3>,
+    /// Their moment on each bracket about its slot (N·mm, world; from power arms).
+    pub chain_moments: Vec<DVec3>,
     /// Wires still to come: the clinical day each is engaged, and the wire.
     pub sequence: Vec<(f64, WireChoice)>,
     /// The wires engaged so far: the day each was, and the wire.
@@ -283,6 +285,7 @@ impl Simulation {
             chains: Vec::new(),
             coils: Vec::new(),
             chain_forces: vec![DVec3::ZERO; n],
+            chain_moments: vec![DVec3::ZERO; n],
             stop: (0..n).min_by(|&a, &b| points[a].x.abs().total_cmp(&points[b].x.abs())),
             last: Equilibrium {
                 iterations: 0,
@@ -453,6 +456,7 @@ impl Simulation {
                 let at = translation + rotation * b.bracket.centre;
                 let mut r = w.reactions[k];
                 r.force += w.chain_forces.get(k).copied().unwrap_or(DVec3::ZERO);
+                r.moment += w.chain_moments.get(k).copied().unwrap_or(DVec3::ZERO);
                 out.push((at, r, Mat6(w.stiffness[k])));
             }
         }

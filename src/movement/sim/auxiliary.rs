@@ -23,6 +23,8 @@ pub struct Chain {
     pub day: f64,
     /// Replaced by a fresh chain at the same stretch every this many days (None: never).
     pub renew_days: Option<f64>,
+    /// Power arms on the `from` and `to` teeth: from the slot towards the root (mm).
+    pub arms: [f64; 2],
     /// Once placed: the day it was and its relaxed length (mm).
     pub placed: Option<(f64, f64)>,
     /// Its tension in the last step (N).
@@ -42,6 +44,8 @@ pub struct Coil {
     pub force: f64,
     /// Activation when placed (mm).
     pub activation: f64,
+    /// Power arms on the `from` and `to` teeth: from the slot towards the root (mm).
+    pub arms: [f64; 2],
     /// Clinical day it is placed.
     pub day: f64,
     /// Once placed: the day it was and its relaxed length (mm).
@@ -69,6 +73,7 @@ impl Simulation {
                 stretch: f64::from(c.stretch.0),
                 day: f64::from(c.day.0),
                 renew_days: c.renew_days.map(|d| f64::from(d.0)).filter(|d| *d > 0.0),
+                arms: [c.from_arm_mm.0, c.to_arm_mm.0].map(f64::from),
                 placed: None,
                 tension_n: 0.0,
             });
@@ -83,6 +88,7 @@ impl Simulation {
                 force: f64::from(c.force_n.0),
                 activation: f64::from(c.activation_mm.0),
                 day: f64::from(c.day.0),
+                arms: [c.from_arm_mm.0, c.to_arm_mm.0].map(f64::from),
                 placed: None,
                 force_n: 0.0,
             });
@@ -142,6 +148,7 @@ impl Simulation {
             stretch,
             day,
             renew_days: None,
+            arms: [0.0; 2],
             placed: None,
             tension_n: 0.0,
         });
@@ -177,34 +184,49 @@ impl Simulation {
             force,
             activation,
             day,
+            arms: [0.0; 2],
             placed: None,
             force_n: 0.0,
         });
         Ok(())
     }
 
-    /// Places wire `k`'s chains and coils that are due and sets each bracket's force from them for
-    /// this step.
+    /// Places wire `k`'s chains and coils that are due and sets each bracket's force and moment
+    /// (about its slot) from them for this step. A chain or coil ending on a power arm pulls at
+    /// the arm's tip, `arm` mm from the slot towards the root along the tooth's long axis, and
+    /// its bracket takes the force and the moment of the force about the slot.
     pub(super) fn pull_chains(&mut self, k: usize) {
-        let slots: Vec<DVec3> = self.wires[k]
-            .brackets
-            .iter()
-            .map(|b| {
-                let (rotation, translation) = world(&self.teeth[b.tooth]);
-                translation + rotation * b.bracket.centre
-            })
-            .collect();
+        let mut slots: Vec<DVec3> = Vec::new();
+        let mut apical: Vec<DVec3> = Vec::new();
+        for b in &self.wires[k].brackets {
+            let t = &self.teeth[b.tooth];
+            let (rotation, translation) = world(t);
+            slots.push(translation + rotation * b.bracket.centre);
+            apical.push(
+                -(rotation * t.shape.geometry.frame.long_axis.as_dvec3()).normalize_or_zero(),
+            );
+        }
         let today = self.elapsed_days;
         let w = &mut self.wires[k];
-        w.chain_forces = vec![DVec3::ZERO; slots.len()];
+        let n = slots.len();
+        w.chain_forces = vec![DVec3::ZERO; n];
+        w.chain_moments = vec![DVec3::ZERO; n];
+        let arm_tip = |i: usize, arm: f64| slots[i] + apical[i] * arm;
+        let pull = |forces: &mut [DVec3], moments: &mut [DVec3], i: usize, arm: f64, f: DVec3| {
+            forces[i] += f;
+            moments[i] += (arm_tip(i, arm) - slots[i]).cross(f);
+        };
         for c in &mut w.chains {
             let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
             let [Some(a), Some(b)] = ends else {
                 continue;
             };
             let (lo, hi) = (a.min(b), a.max(b));
-            let points = &slots[lo..=hi];
-            let length = chain::length(points);
+            let arm = |i: usize| if i == a { c.arms[0] } else { c.arms[1] };
+            let mut points = slots[lo..=hi].to_vec();
+            points[0] = arm_tip(lo, arm(lo));
+            points[hi - lo] = arm_tip(hi, arm(hi));
+            let length = chain::length(&points);
             let due = match (c.placed, c.renew_days) {
                 (None, _) => c.day <= today + 1e-9,
                 (Some((placed, _)), Some(every)) => today - placed >= every - 1e-9,
@@ -217,11 +239,10 @@ impl Simulation {
                 continue;
             };
             c.tension_n = chain::tension_n(length, relaxed, today - placed);
-            for (f, add) in w.chain_forces[lo..=hi]
-                .iter_mut()
-                .zip(chain::forces(points, c.tension_n))
-            {
-                *f += add;
+            for (j, f) in chain::forces(&points, c.tension_n).into_iter().enumerate() {
+                let i = lo + j;
+                let arm = if i == lo || i == hi { arm(i) } else { 0.0 };
+                pull(&mut w.chain_forces, &mut w.chain_moments, i, arm, f);
             }
         }
         for c in &mut w.coils {
@@ -229,7 +250,8 @@ impl Simulation {
             let [Some(a), Some(b)] = ends else {
                 continue;
             };
-            let length = slots[a].distance(slots[b]);
+            let (pa, pb) = (arm_tip(a, c.arms[0]), arm_tip(b, c.arms[1]));
+            let length = pa.distance(pb);
             if c.placed.is_none() && c.day <= today + 1e-9 {
                 let relaxed = match c.kind {
                     coil::CoilKind::Closed => (length - c.activation).max(0.0),
@@ -241,9 +263,9 @@ impl Simulation {
                 continue;
             };
             c.force_n = coil::force_n(c.kind, c.force, relaxed, length);
-            let [fa, fb] = coil::end_forces(c.kind, slots[a], slots[b], c.force_n);
-            w.chain_forces[a] += fa;
-            w.chain_forces[b] += fb;
+            let [fa, fb] = coil::end_forces(c.kind, pa, pb, c.force_n);
+            pull(&mut w.chain_forces, &mut w.chain_moments, a, c.arms[0], fa);
+            pull(&mut w.chain_forces, &mut w.chain_moments, b, c.arms[1], fb);
         }
     }
 }

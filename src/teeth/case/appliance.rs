@@ -228,6 +228,14 @@ pub struct CaseCoil {
     /// Clinical day it is placed (default 0).
     #[serde(default)]
     pub day: NonNegative,
+    /// Power arm on the `from` tooth: the hook's length from the slot towards the root, along
+    /// the long axis (mm; default 0, at the slot), so that the force's line passes nearer the
+    /// centre of resistance.
+    #[serde(default)]
+    pub from_arm_mm: NonNegative,
+    /// Power arm on the `to` tooth (mm; default 0).
+    #[serde(default)]
+    pub to_arm_mm: NonNegative,
 }
 
 fn coil_force() -> NonNegative {
@@ -257,6 +265,14 @@ pub struct CaseChain {
     /// visit (default: never).
     #[serde(default)]
     pub renew_days: Option<NonNegative>,
+    /// Power arm on the `from` tooth: the hook's length from the slot towards the root, along
+    /// the long axis (mm; default 0, at the slot), so that the force's line passes nearer the
+    /// centre of resistance.
+    #[serde(default)]
+    pub from_arm_mm: NonNegative,
+    /// Power arm on the `to` tooth (mm; default 0).
+    #[serde(default)]
+    pub to_arm_mm: NonNegative,
 }
 
 fn half_stretch() -> NonNegative {
