@@ -319,15 +319,12 @@ fn cone(column: &mut [f32], sign: f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::teeth::arch::BetaArch;
+    use crate::teeth::arch::ArchLayout;
     use glam::Quat;
 
+    /// The built-in arrangement's lower arch form.
     fn curve() -> ArchCurve {
-        ArchCurve::new(&BetaArch {
-            width: 50.0,
-            depth: 36.0,
-            front_z: 18.0,
-        })
+        ArchCurve::new(&ArchLayout::default().lower)
     }
 
     /// Ten incisor-like roots along the curve, 7 mm apart: points on a 3 mm-radius column,
