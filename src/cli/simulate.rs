@@ -223,6 +223,19 @@ fn print_table(r: &SimulationReport) {
     for (pair, mm) in &r.ipr_mm {
         println!("IPR {pair}: {mm:.3} mm");
     }
+    for c in &r.cortical_contacts {
+        println!(
+            "root of {} at the {} plate from day {:.0} to day {:.0} (deepest {:.3} mm past it)",
+            c.fdi,
+            match c.plate {
+                orthosim::appliance::Plate::Buccal => "buccal",
+                orthosim::appliance::Plate::Lingual => "lingual",
+            },
+            c.day,
+            c.until_day,
+            c.depth_mm
+        );
+    }
     if r.impacts > 0 {
         println!(
             "{} impacts, {:.3e} µJ of kinetic energy lost",

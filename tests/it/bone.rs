@@ -101,3 +101,43 @@ fn teeth_at_rest_start_inside_the_envelope_and_never_reach_it() {
     }
     assert!(sim.cortical.is_empty());
 }
+
+#[test]
+fn simulate_reports_a_root_at_a_plate_in_its_table_and_json() {
+    let dir = std::env::temp_dir().join(format!("orthosim-bone-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("push.ron");
+    std::fs::write(
+        &case,
+        "Case(name: \"push\", teeth: All, loads: [(teeth: [11], force: Anatomical(buccal: 1.5))], \
+         wire: (upper: Round, lower: Rectangular))",
+    )
+    .unwrap();
+    let run = |json: bool| {
+        let mut args = vec!["simulate", "--case", case.to_str().unwrap(), "--days", "40"];
+        if json {
+            args.push("--json");
+        }
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let table = run(false);
+    assert!(
+        table.contains("root of 11 at the buccal plate from day"),
+        "{table}"
+    );
+    let v: serde_json::Value = serde_json::from_str(&run(true)).unwrap();
+    let first = &v["cortical_contacts"][0];
+    assert_eq!(first["fdi"], 11);
+    assert_eq!(first["plate"], "buccal");
+    assert!(first["depth_mm"].as_f64().unwrap() < 0.05, "{first}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
