@@ -176,12 +176,6 @@ pub struct RootedTooth<'a> {
     pub roots: &'a [Vec3],
 }
 
-fn arch_order(f: Fdi) -> i32 {
-    // Right side (quadrants 1 and 4) from distal to mesial, then the left side.
-    let p = f.position() as i32;
-    if matches!(f.quadrant(), 1 | 4) { -p } else { p }
-}
-
 impl AlveolarEnvelope {
     /// The envelope around `teeth` as placed, about the arch curves `curves` (upper, lower); an
     /// arch with fewer than two rooted teeth gets none.
@@ -196,7 +190,7 @@ impl AlveolarEnvelope {
             if own.len() < 2 {
                 continue;
             }
-            own.sort_by_key(|t| arch_order(t.fdi));
+            own.sort_by_key(|t| t.fdi.arch_index());
             let world: Vec<Vec<Vec3>> = own
                 .iter()
                 .map(|t| t.roots.iter().map(|p| t.pose.transform_point(*p)).collect())
