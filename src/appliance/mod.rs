@@ -3,7 +3,7 @@
 //! pushes back on each bracket with a force and a moment that fade as the teeth align.
 //!
 //! Engine-free (no ECS): the wire's cross-sections ([`section`]), alloys ([`material`]), the
-//! elastic rod and its equilibrium in the slots ([`rod`]), and the banded solver it uses; the
+//! elastic rod and its equilibrium in the slots ([`rod`]), the slots' friction ([`friction`]), and the banded solver it uses; the
 //! alveolar envelope whose cortical plates hold the roots ([`bone`]).
 
 pub mod archwire;
@@ -13,6 +13,7 @@ pub mod bone;
 pub mod bracket;
 pub mod chain;
 pub mod coil;
+pub mod friction;
 pub mod material;
 pub mod prescription;
 pub mod rod;

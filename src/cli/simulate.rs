@@ -160,14 +160,18 @@ fn print_table(r: &SimulationReport) {
                 .collect();
             println!("{arch} wire: {}", seq.join(", then "));
         }
-        println!("{:>5} {:>24} {:>26}", "tooth", "force N", "moment N·mm");
+        println!(
+            "{:>5} {:>24} {:>26} {:>10}",
+            "tooth", "force N", "moment N·mm", "friction N"
+        );
         for b in &a.brackets {
             let v = |x: [f64; 3]| format!("{:7.3} {:7.3} {:7.3}", x[0], x[1], x[2]);
             println!(
-                "{:>5} {:>24} {:>26}{}",
+                "{:>5} {:>24} {:>26} {:>10.3}{}",
                 b.fdi.to_string(),
                 v(b.force_n),
                 v(b.moment_nmm),
+                b.friction_n,
                 if b.engaged { "" } else { "  (passive)" }
             );
         }

@@ -158,6 +158,9 @@ pub struct BracketReport {
     pub moment_nmm: [f64; 3],
     /// True when the wire bears on the slot (outside its play).
     pub engaged: bool,
+    /// The slot's friction on the tooth in the last step (N along the slot's axis, which runs
+    /// mesially on the patient's right and distally on the left).
+    pub friction_n: f64,
 }
 
 /// An elastomeric chain at the end of a run.
@@ -386,12 +389,13 @@ fn appliance_report(
                 .map(|(d, c)| WireReport::of(*d, c))
                 .collect(),
         );
-        for (b, r) in w.brackets.iter().zip(&w.reactions) {
+        for (j, (b, r)) in w.brackets.iter().zip(&w.reactions).enumerate() {
             brackets.push(BracketReport {
                 fdi: b.fdi,
                 force_n: r.force.to_array(),
                 moment_nmm: r.moment.to_array(),
                 engaged: r.force.length() > 1e-9 || r.moment.length() > 1e-9,
+                friction_n: w.friction_n.get(j).copied().unwrap_or(0.0),
             });
         }
     }

@@ -7,7 +7,10 @@ use bevy_egui::egui;
 use crate::{
     appliance::{ArchForm, Prescription, Slot, WireMaterial, WireSize},
     movement::{EditAppliance, SimulationState, sim::WireChoice},
-    teeth::{Arch, Fdi, case::appliance::CoilKind},
+    teeth::{
+        Arch, Fdi,
+        case::appliance::{BracketMaterial, CoilKind, Ligation},
+    },
 };
 
 /// The wire sizes the panel offers (inches), as clinics stock them.
@@ -114,6 +117,22 @@ pub(super) fn section(
             &Prescription::ALL,
             |p| p.name().into(),
             "the brackets' prescription (tip, torque, in-out)",
+        );
+        combo(
+            ui,
+            "ligation",
+            &mut c.ligation,
+            &Ligation::ALL,
+            |l| l.name().into(),
+            "how the wire is tied into the slots: what presses it on the slot's floor, and so part of the friction a tooth slides with",
+        );
+        combo(
+            ui,
+            "brackets",
+            &mut c.bracket_material,
+            &BracketMaterial::ALL,
+            |b| b.name().into(),
+            "the brackets' material: ceramic slots rub half again as hard as steel",
         );
     });
     let running = sim.sim.is_some();

@@ -344,6 +344,15 @@ fn selected(ui: &mut egui::Ui, selection: &Selection, teeth: &WindowTeeth, sim: 
                 ))
                 .on_hover_text("the wire's force on the bracket (world x left, y up, z forward) and its moment");
             }
+            if let Some(f) = s
+                .wires
+                .iter()
+                .find_map(|w| w.friction_of(i))
+                .filter(|f| *f != 0.0)
+            {
+                ui.label(format!("    slot friction: {:.2} N", f.abs()))
+                    .on_hover_text("what the slot's friction takes from the chain or coil sliding this tooth along the wire");
+            }
             if let Some(c) = s
                 .cortical
                 .iter()

@@ -209,9 +209,12 @@ fn a_chain_must_end_on_bonded_teeth() {
     assert!(text.contains("34") && text.contains("bracket"), "{text}");
 }
 
-#[test]
-fn a_closed_coil_closes_an_extraction_space_along_the_wire() {
-    let src = r#"Case(
+/// 13 and 16 of case 1 (first premolars out) pulled together by a 1.5 N closed coil on
+/// 0.019×0.025" steel for 60 days, the slots' friction as `ligation` (a case-file fragment) sets
+/// it: the space closed (mm), the simulation, and the canine's and molar's indices.
+fn coil_closure(ligation: &str) -> (f32, Simulation, usize, usize) {
+    let src = format!(
+        r#"Case(
     name: "coiled",
     bite_opening_mm: 3.0,
     extracted: [14, 24, 34, 44],
@@ -219,11 +222,13 @@ fn a_closed_coil_closes_an_extraction_space_along_the_wire() {
         upper: Some((
             material: stainless_steel,
             size: Rect(0.019, 0.025),
+            {ligation}
             coils: [(from: 13, to: 16, force_n: 1.5, activation_mm: 3.0)],
         )),
     ),
-)"#;
-    let loaded = orthosim::teeth::Case::parse(src, "coiled.ron").unwrap();
+)"#
+    );
+    let loaded = orthosim::teeth::Case::parse(&src, "coiled.ron").unwrap();
     let d = Dentition::build(loaded).unwrap();
     let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
     let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
@@ -239,9 +244,34 @@ fn a_closed_coil_closes_an_extraction_space_along_the_wire() {
     let start = apart(&sim);
     while sim.elapsed_days < 60.0 {
         sim.step();
+        // Friction only ever takes from the coil's pull along each slot: never more than the
+        // pull, never the other way, and nothing where no coil pulls.
+        let w = &sim.wires[0];
+        for (j, b) in w.brackets.iter().enumerate() {
+            let along =
+                (sim.teeth[b.tooth].pose.rotation.as_dquat() * b.bracket.frame) * glam::DVec3::X;
+            let after = w.chain_forces[j].dot(along);
+            let before = after - w.friction_n[j];
+            // (The slot's frame here is the pose's single-precision one: 0.01 N of slack.)
+            assert!(
+                w.friction_n[j] * before <= 0.0 && after * before.signum() >= -1e-2,
+                "{}: pull {before} N, friction {} N",
+                b.fdi,
+                w.friction_n[j]
+            );
+            if before == 0.0 {
+                assert_eq!(w.friction_n[j], 0.0, "{}", b.fdi);
+            }
+        }
     }
+    (start - apart(&sim), sim, c, m)
+}
+
+#[test]
+fn a_closed_coil_closes_an_extraction_space_along_the_wire_against_friction() {
+    // Frictionless slots first: the coil's mechanics alone.
+    let (closed, sim, c, m) = coil_closure("friction: Some(0.0),");
     let coil = &sim.wires[0].coils[0];
-    let closed = start - apart(&sim);
     // The coil pulls its plateau until it has all but closed, then less.
     assert!(coil.placed.is_some() && coil.force_n <= 1.5, "{coil:?}");
     let (_, relaxed) = coil.placed.unwrap();
@@ -252,15 +282,32 @@ fn a_closed_coil_closes_an_extraction_space_along_the_wire() {
     );
     assert!(relaxed > 0.0);
     // The canine and the molar come together at the ligament's pace under a 1.5 N coil, the
-    // anchorage molar less than the canine.
-    // (Clinically about 1 mm of space closes a month under a NiTi coil; measured here 3.2 mm in
-    // two months, most of it while the coil still pulls its plateau.)
+    // anchorage molar less than the canine (3.2 mm in two months, most of it while the coil
+    // still pulls its plateau).
     assert!((1.0..4.0).contains(&closed), "closed {closed} mm");
     assert!(
         sim.teeth[c].displacement_mm() > sim.teeth[m].displacement_mm(),
         "canine {} molar {}",
         sim.teeth[c].displacement_mm(),
         sim.teeth[m].displacement_mm()
+    );
+    assert!(max_penetration(&sim) < 0.05, "{}", max_penetration(&sim));
+    // Elastomeric modules on the steel wire: the canine, tipped against the wire, binds, and
+    // most of the pull goes to friction; the space still closes, more slowly.
+    let (rubbed, sim, _, _) = coil_closure("ligation: elastomeric,");
+    let canine = sim.wires[0]
+        .brackets
+        .iter()
+        .position(|b| b.fdi == fdi(13))
+        .unwrap();
+    assert!(
+        sim.wires[0].friction_n[canine].abs() > 0.3,
+        "{:?}",
+        sim.wires[0].friction_n
+    );
+    assert!(
+        rubbed > 0.05 && rubbed < 0.5 * closed,
+        "with friction {rubbed} mm, without {closed} mm"
     );
     assert!(max_penetration(&sim) < 0.05, "{}", max_penetration(&sim));
 }
@@ -318,7 +365,7 @@ fn case1_chain_closes_the_extraction_spaces_by_sliding_on_the_wire() {
         None,
         RunLimit {
             max_steps: 100_000,
-            max_days: Some(240.0),
+            max_days: Some(365.0),
         },
         |_| {},
     )
@@ -329,7 +376,16 @@ fn case1_chain_closes_the_extraction_spaces_by_sliding_on_the_wire() {
     let a = r.appliance.as_ref().unwrap();
     assert!(a.converged);
     assert_eq!(a.chains.len(), 6);
-    // Each first molar is drawn mesially along its arch by millimetres.
+    // Each first molar is drawn mesially along its arch in a year, against the slots' friction
+    // (much of each chain's pull at the canines and molars goes to it; the anterior block
+    // retracts into the space too: 0.3–2.3 mm of molar travel, 3.1–6.5 mm of canine).
+    let rubbed = a
+        .brackets
+        .iter()
+        .filter(|b| [13, 23, 33, 43, 16, 26, 36, 46].contains(&b.fdi.number()))
+        .filter(|b| b.friction_n.abs() > 0.2)
+        .count();
+    assert!(rubbed >= 6, "{:?}", a.brackets);
     for m in [16, 26, 36, 46] {
         let i = sim.index_of(fdi(m)).unwrap();
         let t = &sim.teeth[i];
@@ -340,16 +396,16 @@ fn case1_chain_closes_the_extraction_spaces_by_sliding_on_the_wire() {
             - t.initial
                 .transform_point(t.shape.geometry.frame.crown_centre))
         .dot(mesial);
-        assert!(moved > 1.5, "{m} moved {moved} mm mesially");
+        assert!(moved > 0.2, "{m} moved {moved} mm mesially");
     }
-    // The extraction spaces (about 7 mm) are mostly closed.
+    // The extraction spaces (about 7 mm) are at least half closed.
     for (a, b) in [(15, 13), (23, 25), (45, 43), (33, 35)] {
         let d = r
             .distances
             .iter()
             .find(|d| (d.a, d.b) == (fdi(a), fdi(b)) || (d.a, d.b) == (fdi(b), fdi(a)))
             .unwrap();
-        assert!(d.surface_gap_mm < 3.0, "{a}-{b}: {} mm", d.surface_gap_mm);
+        assert!(d.surface_gap_mm < 3.5, "{a}-{b}: {} mm", d.surface_gap_mm);
     }
 }
 
@@ -367,6 +423,8 @@ fn a_power_arm_retracts_a_canine_more_bodily() {
         upper: Some((
             material: stainless_steel,
             size: Round(0.016),
+            // Frictionless slots: the arm's couple alone.
+            friction: Some(0.0),
             coils: [(from: 13, to: 16, force_n: 1.5, activation_mm: 3.0, from_arm_mm: {arm})],
         )),
     ),

@@ -25,17 +25,20 @@ use super::{
     auxiliary::{Chain, Coil},
 };
 use crate::{
-    appliance::bracket::WALL_N_PER_MM,
     appliance::{
         ArchForm, ArchSize, Bracket, Equilibrium, Holder, Laid, Prescription, Reaction, Rod,
         Settings, Slot, ToothAxes, WireMaterial, WireSize, fit_form, lay, nearest_on_form,
     },
+    appliance::{bracket::WALL_N_PER_MM, friction},
     geometry::{Mat6, Vec6},
     movement::{
         MovementError,
         pdl::{shifted, wrench},
     },
-    teeth::{Arch, Fdi, Side, ToothKind, case::appliance::CaseAppliance},
+    teeth::{
+        Arch, Fdi, Side, ToothKind,
+        case::appliance::{BracketMaterial, CaseAppliance, Ligation},
+    },
 };
 
 /// Residual force (N) a step's wire solve stops at: a thousandth of the lightest force a wire
@@ -66,6 +69,24 @@ pub struct WireChoice {
     pub slot: Slot,
     /// Brackets' prescription.
     pub prescription: Prescription,
+    /// How the wire is tied into the slots.
+    pub ligation: Ligation,
+    /// The brackets' material.
+    pub bracket_material: BracketMaterial,
+    /// Coefficient of friction in place of the materials' (see
+    /// [`crate::appliance::friction::coefficient`]).
+    pub friction: Option<f64>,
+    /// The wire's ends cinched behind the terminal tubes: they hold the wire as its stop does
+    /// (within [`STOP_PLAY_MM`]).
+    pub cinched: bool,
+}
+
+impl WireChoice {
+    /// The coefficient of friction between this wire and its slots.
+    pub fn mu(&self) -> f64 {
+        self.friction
+            .unwrap_or_else(|| friction::coefficient(self.material, self.bracket_material))
+    }
 }
 
 impl Default for WireChoice {
@@ -76,6 +97,10 @@ impl Default for WireChoice {
             form: ArchForm::Ovoid,
             slot: Slot::S022,
             prescription: Prescription::Mbt,
+            ligation: Ligation::Elastomeric,
+            bracket_material: BracketMaterial::Steel,
+            friction: None,
+            cinched: false,
         }
     }
 }
@@ -130,6 +155,10 @@ pub struct ArchWire {
     pub chain_forces: Vec<DVec3>,
     /// Their moment on each bracket about its slot (N·mm, world; from power arms).
     pub chain_moments: Vec<DVec3>,
+    /// The slot's friction on each bracket's tooth in the last step (N along the slot's axis;
+    /// see [`super::friction`]).
+    pub friction_n: Vec<f64>,
+
     /// Wires still to come: the clinical day each is engaged, and the wire.
     pub sequence: Vec<(f64, WireChoice)>,
     /// The wires engaged so far: the day each was, and the wire.
@@ -143,6 +172,12 @@ impl ArchWire {
     pub fn reaction_of(&self, i: usize) -> Option<Reaction> {
         let k = self.brackets.iter().position(|b| b.tooth == i)?;
         self.reactions.get(k).copied()
+    }
+
+    /// The slot's friction on tooth `i` in the last step (N along its slot), if bonded.
+    pub fn friction_of(&self, i: usize) -> Option<f64> {
+        let k = self.brackets.iter().position(|b| b.tooth == i)?;
+        self.friction_n.get(k).copied()
     }
 }
 
@@ -286,6 +321,7 @@ impl Simulation {
             coils: Vec::new(),
             chain_forces: vec![DVec3::ZERO; n],
             chain_moments: vec![DVec3::ZERO; n],
+            friction_n: vec![0.0; n],
             stop: (0..n).min_by(|&a, &b| points[a].x.abs().total_cmp(&points[b].x.abs())),
             last: Equilibrium {
                 iterations: 0,
@@ -321,6 +357,10 @@ impl Simulation {
                 form: w.form,
                 slot: w.slot,
                 prescription: w.prescription,
+                ligation: w.ligation,
+                bracket_material: w.bracket_material,
+                friction: w.friction.map(|f| f.0 as f64),
+                cinched: w.cinched,
             };
             let teeth: Vec<Fdi> = w
                 .bonded
@@ -397,7 +437,8 @@ impl Simulation {
                 let mut h = b
                     .bracket
                     .holder(b.node, rotation, translation, w.choice.size);
-                if w.stop == Some(i) {
+                let terminal = i == 0 || i + 1 == w.brackets.len();
+                if w.stop == Some(i) || (w.choice.cinched && terminal) {
                     h.play[0] = STOP_PLAY_MM;
                     h.stiffness[0] = WALL_N_PER_MM;
                 }
@@ -440,6 +481,7 @@ impl Simulation {
                 self.solve_wire(k, STEP_ITERATIONS);
             }
             self.pull_chains(k);
+            self.slot_friction(k);
         }
     }
 

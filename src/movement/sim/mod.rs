@@ -60,6 +60,7 @@ mod auxiliary;
 mod blocking;
 mod bone;
 mod editing;
+mod friction;
 mod impulse;
 mod pdl_step;
 mod proposal;

@@ -142,6 +142,66 @@ pub enum ArchForm {
     Square,
 }
 
+/// How the wire is held in each slot: what presses it against the slot's floor, and so part of
+/// the friction it slides with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Ligation {
+    /// An elastomeric module over the tie wings.
+    #[default]
+    Elastomeric,
+    /// A stainless steel ligature, tied and backed off.
+    SteelTie,
+    /// A self-ligating bracket whose gate closes the slot without touching the wire.
+    PassiveSelfLigating,
+    /// A self-ligating bracket whose spring clip presses a full wire into the slot.
+    ActiveSelfLigating,
+}
+
+impl Ligation {
+    /// Every ligation, in the panel's order.
+    pub const ALL: [Self; 4] = [
+        Self::Elastomeric,
+        Self::SteelTie,
+        Self::PassiveSelfLigating,
+        Self::ActiveSelfLigating,
+    ];
+
+    /// As clinicians name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Elastomeric => "elastomeric",
+            Self::SteelTie => "steel tie",
+            Self::PassiveSelfLigating => "passive self-ligating",
+            Self::ActiveSelfLigating => "active self-ligating",
+        }
+    }
+}
+
+/// What the brackets' slots are made of.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BracketMaterial {
+    /// Stainless steel.
+    #[default]
+    Steel,
+    /// Polycrystalline alumina (an aesthetic ceramic bracket).
+    Ceramic,
+}
+
+impl BracketMaterial {
+    /// Every material, in the panel's order.
+    pub const ALL: [Self; 2] = [Self::Steel, Self::Ceramic];
+
+    /// As clinicians name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Steel => "steel",
+            Self::Ceramic => "ceramic",
+        }
+    }
+}
+
 /// Each arch's archwire; an arch with none carries no brackets.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -180,6 +240,20 @@ pub struct CaseArchWire {
     /// The brackets' prescription (default MBT).
     #[serde(default)]
     pub prescription: Prescription,
+    /// How the wire is tied into the slots (default elastomeric modules).
+    #[serde(default)]
+    pub ligation: Ligation,
+    /// The brackets' material (default stainless steel).
+    #[serde(default)]
+    pub bracket_material: BracketMaterial,
+    /// The coefficient of friction between wire and slot, in place of the one the wire's alloy
+    /// and the brackets' material give (e.g. `friction: Some(0.2)`; 0: frictionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<NonNegative>,
+    /// The wire's ends cinched behind the terminal tubes, so that it cannot slide through them
+    /// (default: it slides).
+    #[serde(default)]
+    pub cinched: bool,
     /// The teeth carrying brackets and tubes (default: every tooth of the arch but third
     /// molars).
     #[serde(default)]
@@ -310,6 +384,10 @@ mod tests {
             (WireMaterial::NiTi, WireSize::Round(0.014))
         );
         assert_eq!((w.form, w.slot, w.prescription), Default::default());
+        assert_eq!(
+            (w.ligation, w.bracket_material, w.friction, w.cinched),
+            (Ligation::Elastomeric, BracketMaterial::Steel, None, false)
+        );
         assert!(w.bonded.0.is_empty() && w.sequence.is_empty());
         let w = wire(
             "(material: stainless_steel, size: Rect(0.019, 0.025), slot: 0.018, form: tapered, \
@@ -318,6 +396,25 @@ mod tests {
         .unwrap();
         assert_eq!((w.slot, w.form), (Slot::S018, ArchForm::Tapered));
         assert_eq!(w.sequence[0].day.0, 30.0);
+        let w = wire(
+            "(material: tma, size: Round(0.016), ligation: passive_self_ligating, \
+             bracket_material: ceramic, friction: Some(0.2), cinched: true)",
+        )
+        .unwrap();
+        assert_eq!(
+            (
+                w.ligation,
+                w.bracket_material,
+                w.friction.map(|f| f.0),
+                w.cinched
+            ),
+            (
+                Ligation::PassiveSelfLigating,
+                BracketMaterial::Ceramic,
+                Some(0.2),
+                true
+            )
+        );
         let w = wire(
             "(material: stainless_steel, size: Rect(0.019, 0.025), \
              chains: [(from: 43, to: 33), (from: 44, to: 42, stretch: 0.8, day: 30)])",
@@ -370,6 +467,14 @@ mod tests {
             (
                 "(material: ni_ti, size: Round(0.014), coils: [(from: 13, to: 16, kind: spring)])",
                 "spring",
+            ),
+            (
+                "(material: ni_ti, size: Round(0.014), friction: Some(-0.1))",
+                "negative",
+            ),
+            (
+                "(material: ni_ti, size: Round(0.014), ligation: glue)",
+                "glue",
             ),
         ] {
             let e = wire(src).unwrap_err();
