@@ -470,3 +470,49 @@ fn a_power_arm_retracts_a_canine_more_bodily() {
         "tipped {tip12}° on a 12 mm arm, {tip8}° on 8 mm"
     );
 }
+
+#[test]
+fn a_cinched_wire_holds_its_terminal_tube_where_a_free_one_lets_it_slide() {
+    // An open coil pushing 17 distally from 16 in frictionless slots: the free wire lets 17 slide
+    // back along it; cinched behind 17's tube, the wire holds it within the stop's play.
+    let travel = |cinched: bool| {
+        let src = format!(
+            r#"Case(
+    name: "cinch",
+    bite_opening_mm: 3.0,
+    appliance: (
+        upper: Some((
+            material: stainless_steel,
+            size: Rect(0.019, 0.025),
+            friction: Some(0.0),
+            cinched: {cinched},
+            coils: [(from: 16, to: 17, kind: open, force_n: 1.5, activation_mm: 3.0)],
+        )),
+    ),
+)"#
+        );
+        let d = Dentition::build(orthosim::teeth::Case::parse(&src, "cinch.ron").unwrap()).unwrap();
+        let shapes =
+            collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
+        let mut sim =
+            Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+        let i = sim.index_of(fdi(17)).unwrap();
+        while sim.elapsed_days < 60.0 {
+            sim.step();
+        }
+        let t = &sim.teeth[i];
+        let distal = t
+            .initial
+            .transform_vector(glam::Vec3::X * -t.fdi.local_x_mesial_sign());
+        (t.crown_centre()
+            - t.initial
+                .transform_point(t.shape.geometry.frame.crown_centre))
+        .dot(distal)
+    };
+    let (free, cinched) = (travel(false), travel(true));
+    assert!(free > 0.5, "free wire: 17 moved {free} mm distally");
+    assert!(
+        cinched < 0.6 && cinched < 0.5 * free,
+        "cinched {cinched} mm, free {free} mm"
+    );
+}
