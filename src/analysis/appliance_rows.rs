@@ -67,7 +67,8 @@ pub fn niti_unloading_force() -> f64 {
 }
 
 /// The built-in `crowded` case run for up to 240 clinical days with its wire sequence as
-/// `orthosim simulate --case crowded` runs it (continuous contacts, medial sphere trees): the
+/// `orthosim simulate --case crowded --algorithm exact` runs it (exact contacts: the continuous
+/// stage's leaf spheres stop the anterior teeth short as the chain closes them up): the
 /// first day its lower arch's Little irregularity index is under 1 mm, or NaN when it does not
 /// get there.
 ///
@@ -80,7 +81,7 @@ pub fn crowded_alignment_days(settings: &MovementSettings) -> Result<f64, Analys
     };
     let run = run_case_for(
         "crowded",
-        Method::Continuous,
+        Method::Exact,
         settings,
         TreeSettings::with_method(TreeMethod::Medial),
         None,

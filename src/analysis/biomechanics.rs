@@ -18,7 +18,7 @@
 //! | `niti_unloading_force_n` | the rod, 0.016" NiTi, three-bracket test (7 mm spans) unloading at 2 mm after 3.1 mm | 0.8–1.8 N (Materials Research 2015: 98–151 gf) |
 //! | `chain_force_fraction_day21` | the elastomeric chain's decay at a fixed stretch ([`crate::appliance::chain`]) | 0.25–0.65 (Buchmann 2012: 37–75 % lost) |
 //! | `sliding_force_loss` | case 1's upper canine retracted along 0.016" steel (0.022" slots, elastomeric modules, μ 0.2) by a 2 N closed coil: share of the pull the slot's friction takes, days 7–60 | 0.4–0.85 (Kojima & Fukui 2005, finite elements: about 70 %) |
-//! | `crowded_alignment_days` | the `crowded` case with its wire sequence, as `simulate` runs it (continuous contacts): first day the lower Little index is under 1 mm | 60–240 days (clinical trials) |
+//! | `crowded_alignment_days` | the `crowded` case with its wire sequence, as `simulate --algorithm exact` runs it: first day the lower Little index is under 1 mm | 60–240 days (clinical trials) |
 //!
 //! h is the root length below the crest. `reference` in the output is the accepted range: the
 //! published one with the tolerance the row's source states. The canine row is what the

@@ -13,6 +13,7 @@ pub mod bone;
 pub mod bracket;
 pub mod chain;
 pub mod coil;
+pub mod elastic;
 pub mod friction;
 pub mod material;
 pub mod prescription;

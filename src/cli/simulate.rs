@@ -184,6 +184,15 @@ fn print_table(r: &SimulationReport) {
                 None => println!("chain {}–{}: not placed yet", c.from, c.to),
             }
         }
+        for e in &a.elastics {
+            match e.placed_day {
+                Some(day) => println!(
+                    "elastic {}–{} worn from day {day:.0}: {:.2} N",
+                    e.from, e.to, e.force_n
+                ),
+                None => println!("elastic {}–{}: not worn yet", e.from, e.to),
+            }
+        }
         for c in &a.coils {
             match c.placed_day {
                 Some(day) => println!(

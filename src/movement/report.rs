@@ -191,6 +191,19 @@ pub struct CoilReport {
     pub force_n: f64,
 }
 
+/// An intermaxillary elastic at the end of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ElasticReport {
+    /// One end's tooth.
+    pub from: Fdi,
+    /// The other end's tooth.
+    pub to: Fdi,
+    /// Clinical day it was first worn, if it was.
+    pub placed_day: Option<f64>,
+    /// Force (N; 0 when not worn).
+    pub force_n: f64,
+}
+
 /// The appliances at the end of a run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ApplianceReport {
@@ -204,6 +217,8 @@ pub struct ApplianceReport {
     pub chains: Vec<ChainReport>,
     /// Coil springs at the end: ends, kind and force (N; 0 before placed or once spent).
     pub coils: Vec<CoilReport>,
+    /// Intermaxillary elastics at the end: ends and force (N).
+    pub elastics: Vec<ElasticReport>,
     /// Wire solves per step, all arches (µs: median and most), measured in this run.
     pub solve_us_per_step: [f64; 2],
     /// The median wire solve over the median collision step of this run.
@@ -408,6 +423,16 @@ fn appliance_report(
         brackets,
         chains,
         coils,
+        elastics: sim
+            .elastics
+            .iter()
+            .map(|e| ElasticReport {
+                from: e.from,
+                to: e.to,
+                placed_day: e.placed.map(|(d, _)| d),
+                force_n: e.force_n,
+            })
+            .collect(),
         solve_us_per_step: [solve, most],
         solve_over_collision: if collision > 0.0 {
             solve / collision

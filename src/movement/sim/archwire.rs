@@ -398,7 +398,7 @@ impl Simulation {
                 last.coils = coils;
             }
         }
-        Ok(())
+        self.case_elastics(&spec.elastics)
     }
 
     /// Takes wire `k` out and engages `choice` through the same brackets, laid on the same arch
@@ -481,6 +481,9 @@ impl Simulation {
                 self.solve_wire(k, STEP_ITERATIONS);
             }
             self.pull_chains(k);
+        }
+        self.pull_elastics();
+        for k in 0..self.wires.len() {
             self.slot_friction(k);
         }
     }

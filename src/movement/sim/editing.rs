@@ -162,6 +162,7 @@ impl Simulation {
             elapsed_days: 0.0,
             known: BTreeMap::new(),
             wires: Vec::new(),
+            elastics: Vec::new(),
             contact_points: d.contact_points.clone(),
             setup: d.setup.clone(),
             bone: None,
@@ -389,6 +390,12 @@ impl Simulation {
                 next.bond(w.arch, w.choice, &teeth)?;
             }
         }
+        next.elastics = self
+            .elastics
+            .iter()
+            .filter(|e| next.slot_of(e.from).is_some() && next.slot_of(e.to).is_some())
+            .cloned()
+            .collect();
         Ok(next)
     }
 }

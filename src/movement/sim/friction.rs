@@ -8,10 +8,15 @@
 //! under the wire's reaction of this step, binding couples included, plus the ligation's seating
 //! force on brackets (a molar's tube has no ligature) ([`crate::appliance::friction`]). The force so lost is each bracket's `friction_n`.
 //!
+//! What friction takes from a tooth it gives to the wire, which is held in every slot and at its
+//! stop: the sum is shared equally by the arch's brackets, so that the arch's forces still
+//! balance and an elastic's pull still reaches the whole arch (as a force on each tooth, not
+//! resolved by where the wire bears).
+//!
 //! Departure, and its bound: friction is applied to the forces that slide teeth along the wire
-//! (chains, coils), where sliding mechanics lose their force. The wire itself runs freely
-//! through the slots (it carries no force along them but at its stop and cinches), and a tooth
-//! pushed along the wire by its neighbours' contacts slides without friction. A fully coupled
+//! (chains, coils, elastics), where sliding mechanics lose their force. The wire itself runs
+//! freely through the other slots (it carries no force along them but at its stop and cinches),
+//! and a tooth pushed along the wire by its neighbours' contacts slides without friction. A fully coupled
 //! stick–slip of the wire in every slot (friction in the wire's own equilibrium) was tried and
 //! left aside: its lagged normal force fed back through the binding couples and made canine
 //! retraction chaotic.
@@ -38,6 +43,7 @@ impl Simulation {
             return;
         }
         let seating = friction::seating_force_n(w.choice.ligation, w.choice.size, w.choice.slot);
+        let mut held = DVec3::ZERO;
         for j in 0..n.min(w.chain_forces.len()) {
             let along = frames[j] * DVec3::X;
             let pull = w.chain_forces[j].dot(along);
@@ -60,6 +66,12 @@ impl Simulation {
             let lost = (mu * normal).min(pull.abs()) * -pull.signum();
             w.chain_forces[j] += along * lost;
             w.friction_n[j] = lost;
+            held -= along * lost;
+        }
+        // The wire passes what friction took on to the whole arch, shared by its brackets.
+        let share = held / n.max(1) as f64;
+        for f in &mut w.chain_forces {
+            *f += share;
         }
     }
 }

@@ -60,6 +60,7 @@ mod auxiliary;
 mod blocking;
 mod bone;
 mod editing;
+mod elastics;
 mod friction;
 mod impulse;
 mod pdl_step;
@@ -68,6 +69,7 @@ mod proposal;
 pub use archwire::{ArchWire, Bonded, STEP_ITERATIONS, STEP_TOLERANCE_N, WireChoice};
 pub use auxiliary::{Chain, Coil};
 pub use bone::{CorticalContact, PLATE_CONTACT_MM, RETURN_MM_PER_STEP};
+pub use elastics::Elastic;
 pub use pdl_step::{MAX_SWEEPS, PUSH_BIAS_MM, PdlState, SOLVE_TOLERANCE_MM};
 
 use super::{
@@ -271,6 +273,8 @@ pub struct Simulation {
     known: BTreeMap<(usize, usize), EndOverlap>,
     /// Archwires with their brackets, at most one per arch.
     pub wires: Vec<ArchWire>,
+    /// Intermaxillary elastics between the arches' brackets.
+    pub elastics: Vec<Elastic>,
     /// The anterior teeth's anatomic contact points (Little's irregularity index).
     pub contact_points: ContactPoints,
     /// Where teeth stand aligned, where known ([`crate::teeth::Dentition::setup`]): brackets are

@@ -212,10 +212,34 @@ pub struct CaseAppliance {
     /// The lower arch's wire.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lower: Option<CaseArchWire>,
+    /// Intermaxillary elastics, each from a bonded tooth of one arch to one of the other.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub elastics: Vec<CaseElastic>,
+}
+
+/// An intermaxillary elastic worn from `day` between the brackets (or tubes) of `from` and `to`,
+/// teeth of opposite arches, rated `force_n` at the stretch it is worn at, e.g. Class II
+/// `(from: 13, to: 46, force_n: 1.5)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseElastic {
+    /// One end's tooth.
+    pub from: super::super::fdi::Fdi,
+    /// The other end's tooth, in the other arch.
+    pub to: super::super::fdi::Fdi,
+    /// Its rated force where worn (N; default 1.5, about 150 g).
+    #[serde(default = "coil_force")]
+    pub force_n: NonNegative,
+    /// Clinical day it is first worn (default 0).
+    #[serde(default)]
+    pub day: NonNegative,
+    /// Clinical day it is last worn (default: to the end).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub until_day: Option<NonNegative>,
 }
 
 impl CaseAppliance {
-    /// True when neither arch has a wire.
+    /// True when neither arch has a wire (and so nothing is bonded).
     pub fn is_empty(&self) -> bool {
         self.upper.is_none() && self.lower.is_none()
     }
