@@ -172,6 +172,15 @@ pub enum EditAppliance {
         /// Strain when placed.
         stretch: f64,
     },
+    /// An intermaxillary elastic between bonded teeth of the two arches, rated `force_n`.
+    Elastic {
+        /// One end.
+        from: Fdi,
+        /// The other end (the other arch).
+        to: Fdi,
+        /// Rated force (N).
+        force_n: f64,
+    },
     /// A NiTi coil spring between two bonded teeth.
     Coil {
         /// One end.
@@ -472,6 +481,7 @@ fn edit_appliances(mut state: ResMut<SimulationState>, mut messages: MessageRead
                 Ok(())
             }
             EditAppliance::Chain { from, to, stretch } => sim.add_chain(*from, *to, *stretch),
+            EditAppliance::Elastic { from, to, force_n } => sim.add_elastic(*from, *to, *force_n),
             EditAppliance::Coil {
                 from,
                 to,

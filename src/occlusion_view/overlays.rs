@@ -300,11 +300,19 @@ pub(super) fn draw_overlays(
 }
 
 const WIRE_COLOUR: Color = Color::srgb(0.86, 0.88, 0.92);
+/// Elastomeric chains.
+const CHAIN_COLOUR: Color = Color::srgb(0.62, 0.36, 0.82);
+/// NiTi coil springs.
+const COIL_COLOUR: Color = Color::srgb(0.95, 0.72, 0.25);
+/// Intermaxillary elastics (latex).
+const ELASTIC_COLOUR: Color = Color::srgb(0.95, 0.55, 0.35);
 /// Force on a bracket drawn fully red (N).
 const BRACKET_FULL_N: f64 = 2.0;
 
 /// The archwires in their deformed shape, and each bracket's slot as a box turned as the slot is,
-/// coloured from blue (the wire passive in it) to red ([`BRACKET_FULL_N`] or more on it).
+/// coloured from blue (the wire passive in it) to red ([`BRACKET_FULL_N`] or more on it); the
+/// chains over their brackets, the coils and the intermaxillary elastics once placed, as lines
+/// between their slots.
 pub(super) fn draw_appliances(
     mut gizmos: Gizmos,
     state: Option<Res<crate::movement::SimulationState>>,
@@ -332,6 +340,32 @@ pub(super) fn draw_appliances(
                     .with_scale(size),
                 colour,
             );
+        }
+    }
+    let slot = |f: crate::teeth::Fdi| {
+        sim.wires.iter().find_map(|w| {
+            let b = w.brackets.iter().find(|b| b.fdi == f)?;
+            let t = sim.teeth.get(b.tooth)?;
+            Some(t.pose.transform_point(b.bracket.centre.as_vec3()))
+        })
+    };
+    for w in &sim.wires {
+        for c in w.chains.iter().filter(|c| c.placed.is_some()) {
+            let ends = [c.from, c.to].map(|f| w.brackets.iter().position(|b| b.fdi == f));
+            if let [Some(a), Some(b)] = ends {
+                let run = &w.brackets[a.min(b)..=a.max(b)];
+                gizmos.linestrip(run.iter().filter_map(|b| slot(b.fdi)), CHAIN_COLOUR);
+            }
+        }
+        for c in w.coils.iter().filter(|c| c.placed.is_some()) {
+            if let (Some(a), Some(b)) = (slot(c.from), slot(c.to)) {
+                gizmos.line(a, b, COIL_COLOUR);
+            }
+        }
+    }
+    for e in sim.elastics.iter().filter(|e| e.force_n > 0.0) {
+        if let (Some(a), Some(b)) = (slot(e.from), slot(e.to)) {
+            gizmos.line(a, b, ELASTIC_COLOUR);
         }
     }
 }

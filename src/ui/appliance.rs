@@ -1,5 +1,6 @@
 //! The **Appliance** part of the teeth window: choose a wire and bond an arch (the selected teeth,
-//! or all of it), take a wire off, and place a chain or a coil spring between two selected teeth.
+//! or all of it), take a wire off, and place a chain, a coil spring or an intermaxillary elastic
+//! between two selected teeth.
 
 use bevy::prelude::*;
 use bevy_egui::egui;
@@ -196,6 +197,19 @@ pub(super) fn section(
                 from,
                 to,
                 stretch: editor.stretch,
+            });
+        }
+        let across = pair.filter(|(a, b)| a.arch() != b.arch());
+        if ui
+            .add_enabled(across.is_some(), egui::Button::new("elastic"))
+            .on_hover_text("an intermaxillary elastic (Class II or III) between the two selected teeth, one in each arch, rated at the coil force below")
+            .clicked()
+            && let Some((from, to)) = across
+        {
+            out.write(EditAppliance::Elastic {
+                from,
+                to,
+                force_n: editor.coil_force_n,
             });
         }
     });
