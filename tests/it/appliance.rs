@@ -14,6 +14,14 @@ fn fdi(n: u8) -> Fdi {
     Fdi::new(n as i64).unwrap()
 }
 
+/// The PDL simulation (exact contacts, octree trees) of the case written in `src`, read as
+/// file `name`.
+fn case_sim(src: &str, name: &str) -> Simulation {
+    let d = Dentition::build(orthosim::teeth::Case::parse(src, name).unwrap()).unwrap();
+    let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
+    Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap()
+}
+
 /// The normal case with no loads, its PDL simulation.
 fn normal() -> Simulation {
     let mut loaded = Case::resolve("normal").unwrap();
@@ -228,10 +236,7 @@ fn coil_closure(ligation: &str) -> (f32, Simulation, usize, usize) {
     ),
 )"#
     );
-    let loaded = orthosim::teeth::Case::parse(&src, "coiled.ron").unwrap();
-    let d = Dentition::build(loaded).unwrap();
-    let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
-    let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+    let mut sim = case_sim(&src, "coiled.ron");
     let (c, m) = (
         sim.index_of(fdi(13)).unwrap(),
         sim.index_of(fdi(16)).unwrap(),
@@ -438,11 +443,7 @@ fn a_power_arm_retracts_a_canine_more_bodily() {
     ),
 )"#
         );
-        let d = Dentition::build(orthosim::teeth::Case::parse(&src, "arm.ron").unwrap()).unwrap();
-        let shapes =
-            collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
-        let mut sim =
-            Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+        let mut sim = case_sim(&src, "arm.ron");
         let c = sim.index_of(fdi(13)).unwrap();
         while sim.elapsed_days < 30.0 {
             sim.step();
@@ -499,11 +500,7 @@ fn a_cinched_wire_holds_its_terminal_tube_where_a_free_one_lets_it_slide() {
     ),
 )"#
         );
-        let d = Dentition::build(orthosim::teeth::Case::parse(&src, "cinch.ron").unwrap()).unwrap();
-        let shapes =
-            collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
-        let mut sim =
-            Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+        let mut sim = case_sim(&src, "cinch.ron");
         let i = sim.index_of(fdi(17)).unwrap();
         while sim.elapsed_days < 60.0 {
             sim.step();
@@ -541,12 +538,7 @@ fn class_ii_elastics_retract_the_upper_arch_and_bring_the_lower_forward() {
     ),
 )"#
         );
-        let d =
-            Dentition::build(orthosim::teeth::Case::parse(&src, "class2.ron").unwrap()).unwrap();
-        let shapes =
-            collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
-        let mut sim =
-            Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+        let mut sim = case_sim(&src, "class2.ron");
         while sim.elapsed_days < 60.0 {
             sim.step();
         }
