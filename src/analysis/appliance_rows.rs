@@ -3,13 +3,16 @@
 
 use glam::DVec3;
 
-use super::{AnalysisError, biomechanics::ValidationRow};
+use super::{
+    AnalysisError,
+    biomechanics::{ValidationRow, bare_case1, tooth},
+};
 use crate::{
     appliance::{Holder, Reaction, Rod, Settings, WireMaterial, WireSize, coil::CoilKind},
     collision::{Method, collision_shapes},
     movement::{MovementModel, MovementSettings, RunLimit, Simulation, WireChoice, run_case_for},
     sphere_tree::{TreeMethod, TreeSettings},
-    teeth::{Arch, Case, Dentition, Fdi},
+    teeth::Arch,
 };
 
 /// A straight wire along x over `span` mm, centred on the origin, in `elements` elements.
@@ -107,11 +110,7 @@ pub fn crowded_alignment_days(settings: &MovementSettings) -> Result<f64, Analys
 /// # Errors
 /// The case cannot be built, bonded or simulated.
 pub fn sliding_force_loss(settings: &MovementSettings, days: f64) -> Result<f64, AnalysisError> {
-    let mut loaded = Case::resolve("case1")?;
-    loaded.case.loads.clear();
-    loaded.case.constraints.clear();
-    loaded.case.appliance = Default::default();
-    let d = Dentition::build(loaded)?;
+    let d = bare_case1()?;
     let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None)?;
     let settings = MovementSettings {
         model: MovementModel::Pdl,
@@ -120,8 +119,7 @@ pub fn sliding_force_loss(settings: &MovementSettings, days: f64) -> Result<f64,
     // The exact stage: the canine turns as it is drawn back, and the continuous stage's leaf
     // spheres would hold it against the lateral incisor.
     let mut sim = Simulation::new(&d, shapes, Method::Exact, settings)?;
-    let canine = Fdi::new(13).expect("a valid FDI number");
-    let molar = Fdi::new(16).expect("a valid FDI number");
+    let (canine, molar) = (tooth(13), tooth(16));
     let choice = WireChoice {
         material: WireMaterial::StainlessSteel,
         size: WireSize::Round(0.016),

@@ -137,7 +137,20 @@ fn geometry(
     crate::teeth::ShapeSet::shared(resolution).get(arch, kind)
 }
 
-fn tooth(n: u8) -> Fdi {
+/// Case 1 (first premolars extracted) with none of its loads, constraints or appliances: the
+/// teeth alone, for a rig to load.
+///
+/// # Errors
+/// The case cannot be built.
+pub(super) fn bare_case1() -> Result<Dentition, AnalysisError> {
+    let mut loaded = Case::resolve("case1")?;
+    loaded.case.loads.clear();
+    loaded.case.constraints.clear();
+    loaded.case.appliance = Default::default();
+    Ok(Dentition::build(loaded)?)
+}
+
+pub(super) fn tooth(n: u8) -> Fdi {
     Fdi::new(n as i64).expect("a valid FDI number")
 }
 
@@ -283,10 +296,7 @@ pub fn validate(
 /// # Errors
 /// The case cannot be built or simulated.
 pub fn canine_retraction(settings: &MovementSettings, days: f64) -> Result<f64, AnalysisError> {
-    let mut loaded = Case::resolve("case1")?;
-    loaded.case.loads.clear();
-    loaded.case.constraints.clear();
-    let mut d = Dentition::build(loaded)?;
+    let mut d = bare_case1()?;
     let canine = tooth(13);
     let mut distal = Vec3::ZERO;
     for t in &mut d.teeth {

@@ -168,16 +168,19 @@ pub struct ArchWire {
 }
 
 impl ArchWire {
+    /// The index of the bracket bonded on tooth `i` (index in the simulation).
+    fn bracket_on(&self, i: usize) -> Option<usize> {
+        self.brackets.iter().position(|b| b.tooth == i)
+    }
+
     /// The reaction on the bracket of tooth `i`, if bonded.
     pub fn reaction_of(&self, i: usize) -> Option<Reaction> {
-        let k = self.brackets.iter().position(|b| b.tooth == i)?;
-        self.reactions.get(k).copied()
+        self.reactions.get(self.bracket_on(i)?).copied()
     }
 
     /// The slot's friction on tooth `i` in the last step (N along its slot), if bonded.
     pub fn friction_of(&self, i: usize) -> Option<f64> {
-        let k = self.brackets.iter().position(|b| b.tooth == i)?;
-        self.friction_n.get(k).copied()
+        self.friction_n.get(self.bracket_on(i)?).copied()
     }
 }
 

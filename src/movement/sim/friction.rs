@@ -30,18 +30,18 @@ impl Simulation {
     /// Takes the slots' friction off wire `k`'s chain and coil forces along the slots (see the
     /// module doc) and records it per bracket.
     pub(super) fn slot_friction(&mut self, k: usize) {
-        let mut frames = Vec::new();
-        for b in &self.wires[k].brackets {
-            let (rotation, _) = world(&self.teeth[b.tooth]);
-            frames.push((rotation * b.bracket.frame).normalize());
-        }
-        let w = &mut self.wires[k];
-        let n = w.brackets.len();
-        w.friction_n = vec![0.0; n];
-        let mu = w.choice.mu();
+        let n = self.wires[k].brackets.len();
+        self.wires[k].friction_n = vec![0.0; n];
+        let mu = self.wires[k].choice.mu();
         if mu <= 0.0 {
             return;
         }
+        let frames: Vec<_> = self.wires[k]
+            .brackets
+            .iter()
+            .map(|b| (world(&self.teeth[b.tooth]).0 * b.bracket.frame).normalize())
+            .collect();
+        let w = &mut self.wires[k];
         let seating = friction::seating_force_n(w.choice.ligation, w.choice.size, w.choice.slot);
         let mut held = DVec3::ZERO;
         for j in 0..n.min(w.chain_forces.len()) {
