@@ -234,7 +234,7 @@ mod tests {
         // Unloading at 2 mm well below loading at 2 mm, and falling on the way back.
         assert!(f[3] < 0.8 * f[1], "{f:?}");
         assert!(f[4] < f[3] && f[3] < f[2], "{f:?}");
-        // Steel keeps no memory: the same force both ways.
+        // Steel keeps no memory: the same force both ways (to the solves' 0.01 mN).
         let mut steel = straight(
             14.0,
             28,
@@ -242,6 +242,6 @@ mod tests {
             WireMaterial::StainlessSteel,
         );
         let s = bend_through(&mut steel, &[0.2, 0.4, 0.2]).unwrap();
-        assert!((s[0] - s[2]).abs() < 1e-6 * s[0], "{s:?}");
+        assert!((s[0] - s[2]).abs() < 1e-4 * s[0], "{s:?}");
     }
 }

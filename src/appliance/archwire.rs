@@ -29,7 +29,7 @@ use super::rod::RodNode;
 /// Length of straight wire past each end of the form (mm).
 pub const TAIL_MM: f64 = 3.0;
 /// Spacing of the wire's nodes (mm).
-pub const SPACING_MM: f64 = 1.0;
+pub const SPACING_MM: f64 = 2.0;
 
 /// The size of an arch form: first molar to first molar width and the depth from there to the
 /// incisors (mm, in the occlusal plane, at the slots).
@@ -300,11 +300,27 @@ pub fn lay(
     // Each bracket's nearest place on the form (or its straight tails), by arc length.
     let nearest = |p: DVec3| -> f64 {
         let flat = DVec3::new(p.x, y, p.z);
-        let (mut best, mut s_best) = (f64::INFINITY, 0.0);
+        let (mut best, mut i_best) = (f64::INFINITY, 0);
         for (i, x) in xs.iter().enumerate() {
             let d = at(*x).distance_squared(flat);
             if d < best {
-                (best, s_best) = (d, arc[i]);
+                (best, i_best) = (d, i);
+            }
+        }
+        // Between the nearest sample and its neighbours: the foot of the perpendicular on the
+        // nearer of the two chords (the samples alone would snap a bracket up to half a sample
+        // along the arch).
+        let mut s_best = arc[i_best];
+        for j in [i_best.saturating_sub(1), i_best] {
+            if j + 1 > samples {
+                continue;
+            }
+            let (a, b) = (at(xs[j]), at(xs[j + 1]));
+            let ab = b - a;
+            let f = ((flat - a).dot(ab) / ab.length_squared().max(1e-18)).clamp(0.0, 1.0);
+            let d = (a + ab * f).distance_squared(flat);
+            if d < best {
+                (best, s_best) = (d, arc[j] + f * (arc[j + 1] - arc[j]));
             }
         }
         if s_best <= 0.0 {

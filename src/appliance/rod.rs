@@ -17,14 +17,19 @@
 //! **Guarantee.** [`Rod::solve`] returns when every nodal force is below
 //! [`Settings::tolerance_n`] (N, and N·mm for moments), or says it did not converge; with
 //! steel and TMA, the equilibrium is that of the discrete model, which converges to beam theory as
-//! elements shorten (one-point strain sampling: a cantilever's tip deflection within 1 % at 20
-//! elements; tests check cantilever, three-point bending and torsion). A wire in its passive
+//! elements shorten; with one-point strain sampling and the shear softened by the residual
+//! bending flexibility (MacNeal), a straight span loaded at its nodes bends as beam theory says
+//! however few elements it has (a 5 mm span between two slots within 0.5 % in two elements;
+//! tests check cantilever, three-point bending, torsion and that span). A wire in its passive
 //! shape, held where it lies, carries no force at all. The strains' derivatives are exact (the
 //! rotation group's left Jacobian). Far from equilibrium the tangent is their Gauss–Newton
 //! part (positive semi-definite, so every step goes downhill); once a full step is taken the
 //! geometric stiffness (the stress resultants on the strains' curvature, by differences of the
 //! exact derivatives) is added for Newton's quadratic convergence. A line search on the energy
 //! keeps every step monotone, and the tangent's factor is reused while it quarters the residual.
+//! A step the line search cuts short stiffens the next tangent's diagonal (Levenberg–Marquardt:
+//! a wire free within its slots' play is nearly a mechanism, and an undamped tangent sends it
+//! millimetres along the arch); full steps relax the damping back to pure Newton.
 
 use glam::{DQuat, DVec3};
 
@@ -89,6 +94,9 @@ impl RodNode {
 struct Element {
     length: f64,
     rest: [f64; 6],
+    /// Shear stiffness across the height and across the depth (N), less its residual bending
+    /// flexibility (see [`Rod::new`]).
+    shear: [f64; 2],
     state: Transformation,
 }
 
@@ -111,6 +119,19 @@ pub struct Reaction {
     /// Moment on the holder about its slot's centre (N·mm).
     pub moment: DVec3,
 }
+
+/// Residual force (N, and N·mm for moments) a simulation step's wire solve stops at: under a
+/// percent of the 0.3–2 N a wire moves teeth with, and a hundred times looser than
+/// [`Settings::default`], which the beam-theory checks use (a step's Newton iterations mostly go
+/// to the last digits, against slots' walls that switch on and off).
+pub const STEP_TOLERANCE_N: f64 = 1e-3;
+/// Most Newton iterations of a simulation step's solve, before the simulation tries again with
+/// more.
+pub const STEP_ITERATIONS: usize = 40;
+
+/// How far the wire slides each way through the bracket carrying its stop before the stop bears
+/// on the bracket (mm): a stop crimped on the wire half a millimetre from each side.
+pub const STOP_PLAY_MM: f64 = 0.5;
 
 /// How hard [`Rod::solve`] works.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -180,9 +201,19 @@ impl Rod {
             .windows(2)
             .map(|w| {
                 let length = w[0].x.distance(w[1].x).max(1e-9);
+                // MacNeal's residual bending flexibility: a two-node element with its curvature
+                // sampled once is too stiff in bending by a shear-like h²/12EI, which softening
+                // its shear by as much cancels (nodal displacements of a linear beam under end
+                // loads then exact at any element length). Shear across the height pairs with
+                // bending about the depth axis and the other way round.
+                let soften = |ga: f64, ei: f64| 1.0 / (1.0 / ga + length * length / (12.0 * ei));
                 Element {
                     length,
                     rest: strains(&w[0], &w[1], length),
+                    shear: [
+                        soften(stiffness[1], stiffness[5]),
+                        soften(stiffness[2], stiffness[4]),
+                    ],
                     state: Transformation::default(),
                 }
             })
@@ -236,9 +267,17 @@ impl Rod {
     fn resultants(&self, e: &Element, s: &[f64; 6]) -> ([f64; 6], [[f64; 6]; 6]) {
         let mut c = [[0.0; 6]; 6];
         let mut d = [0.0; 6];
+        let k = [
+            self.stiffness[0],
+            e.shear[0],
+            e.shear[1],
+            self.stiffness[3],
+            self.stiffness[4],
+            self.stiffness[5],
+        ];
         for i in 0..6 {
             d[i] = s[i] - e.rest[i];
-            c[i][i] = self.stiffness[i];
+            c[i][i] = k[i];
         }
         let bend = (d[4] * d[4] + d[5] * d[5]).sqrt();
         let scale = self.material.bending_scale(bend, self.size, &e.state);
@@ -259,7 +298,7 @@ impl Rod {
         }
         let mut f = [0.0; 6];
         for i in 0..4 {
-            f[i] = self.stiffness[i] * d[i];
+            f[i] = k[i] * d[i];
         }
         f[4] = self.stiffness[4] * scale * d[4];
         f[5] = self.stiffness[5] * scale * d[5];
@@ -395,6 +434,7 @@ impl Rod {
         holders: &[Holder],
         loads: &[NodeLoad],
         geometric_too: bool,
+        damping: f64,
     ) -> Option<Factor> {
         let Tangent {
             material: mut k,
@@ -403,7 +443,8 @@ impl Rod {
         let n = k.order();
         let largest = (0..n).map(|i| k.get(i, i)).fold(0.0f64, f64::max).max(1.0);
         for i in 0..n {
-            k.add(i, i, 1e-10 * largest + 1e-9);
+            let d = k.get(i, i);
+            k.add(i, i, damping * d + 1e-10 * largest + 1e-9);
         }
         if geometric_too {
             let mut full = k.clone();
@@ -435,6 +476,7 @@ impl Rod {
         // quadratic convergence near equilibrium, back to the material part when a step is cut
         // short.
         let mut geometric_too = false;
+        let mut damping = 0.0f64;
         while residual > settings.tolerance_n && iterations < settings.max_iterations {
             iterations += 1;
             let mut step: Vec<f64> = g.iter().map(|v| -v).collect();
@@ -444,7 +486,7 @@ impl Rod {
             }
             let descends = g.iter().zip(&step).map(|(a, b)| a * b).sum::<f64>() < 0.0;
             if self.factor.is_none() || !descends {
-                let Some(f) = self.tangent_factor(holders, loads, geometric_too) else {
+                let Some(f) = self.tangent_factor(holders, loads, geometric_too, damping) else {
                     break;
                 };
                 step = g.iter().map(|v| -v).collect();
@@ -511,6 +553,16 @@ impl Rod {
                 self.factor = None;
             }
             geometric_too = hi >= 1.0;
+            // Levenberg–Marquardt: a step the line search had to cut short means the tangent
+            // promised too much (a wire free within its slots' play is soft in whole-wire
+            // slides and turns); the next tangent stiffens its diagonal, a full step relaxes it.
+            damping = if hi < 0.5 {
+                (damping * 10.0).clamp(1e-4, 1.0)
+            } else if damping < 1e-8 {
+                0.0
+            } else {
+                damping * 0.1
+            };
         }
         let converged = residual <= settings.tolerance_n;
         if converged && self.material.superelastic() {
@@ -558,16 +610,16 @@ impl Rod {
     /// stiffness `A` at its node and the node's block `S` of the tangent's inverse. Zero for a
     /// holder the wire does not bear on. Exact to first order about the last equilibrium.
     pub fn holder_stiffness(&mut self, holders: &[Holder]) -> Vec<[[f64; 6]; 6]> {
-        let n = self.nodes.len() * DOF;
         // A fresh material tangent where the wire stands: a stale one may lack walls the wire
         // now bears on (its inverse would then exceed the walls' and the result turn negative).
-        self.factor = self.tangent_factor(holders, &[], false);
-        let mut e = vec![0.0; n];
+        self.factor = self.tangent_factor(holders, &[], false, 0.0);
+        // The inverse's diagonal blocks, all at once.
+        let inverse = self.factor.as_ref().map(Factor::inverse_band);
         holders
             .iter()
             .map(|h| {
                 let mut out = [[0.0; 6]; 6];
-                let (Some(f), Some(node)) = (&self.factor, self.nodes.get(h.node)) else {
+                let (Some(z), Some(node)) = (&inverse, self.nodes.get(h.node)) else {
                     return out;
                 };
                 let (_, k) = h.resultants(&h.offsets(node));
@@ -578,15 +630,9 @@ impl Rod {
                 let a: [[f64; 6]; 6] = std::array::from_fn(|i| {
                     std::array::from_fn(|j| (0..6).map(|r| jac[r][i] * k[r] * jac[r][j]).sum())
                 });
-                let mut inv = [[0.0; 6]; 6];
-                for col in 0..6 {
-                    e.fill(0.0);
-                    e[h.node * DOF + col] = 1.0;
-                    f.solve(&mut e);
-                    for (row, line) in inv.iter_mut().enumerate() {
-                        line[col] = e[h.node * DOF + row];
-                    }
-                }
+                let base = h.node * DOF;
+                let inv: [[f64; 6]; 6] =
+                    std::array::from_fn(|i| std::array::from_fn(|j| z.get(base + i, base + j)));
                 let mul = |x: &[[f64; 6]; 6], y: &[[f64; 6]; 6]| -> [[f64; 6]; 6] {
                     std::array::from_fn(|i| {
                         std::array::from_fn(|j| (0..6).map(|m| x[i][m] * y[m][j]).sum())

@@ -41,18 +41,10 @@ use crate::{
     },
 };
 
-/// Residual force (N) a step's wire solve stops at: a thousandth of the lightest force a wire
-/// moves a tooth with.
-pub const STEP_TOLERANCE_N: f64 = 1e-4;
-/// Most Newton iterations of a step's solve, before it tries again with
-/// [`ENGAGE_ITERATIONS`].
-pub const STEP_ITERATIONS: usize = 40;
+pub use crate::appliance::rod::{STEP_ITERATIONS, STEP_TOLERANCE_N, STOP_PLAY_MM};
 /// Farthest a bracket is moved up or down its tooth from the bracket point to level its slot
 /// (mm): about a third of a crown's height.
 pub const MAX_HEIGHT_SHIFT_MM: f64 = 2.5;
-/// How far the wire slides each way through the bracket carrying its stop before the stop bears
-/// on the bracket (mm): a stop crimped on the wire half a millimetre from each side.
-pub const STOP_PLAY_MM: f64 = 0.5;
 /// Most Newton iterations when a wire is engaged, or a step's solve needs more.
 pub const ENGAGE_ITERATIONS: usize = 200;
 
@@ -460,7 +452,11 @@ impl Simulation {
         w.last = equilibrium(&mut w.rod, &holders, iterations);
         if w.last.converged {
             w.reactions = w.rod.reactions(&holders);
-            w.stiffness = w.rod.holder_stiffness(&holders);
+            // A wire already in balance where the brackets now stand bears on the same walls:
+            // its stiffness at the brackets is the last step's.
+            if w.last.iterations > 0 || w.stiffness.len() != holders.len() {
+                w.stiffness = w.rod.holder_stiffness(&holders);
+            }
         } else {
             // No equilibrium found: the wire stays as it was and the brackets keep the last
             // step's loads (never forces from a wire out of balance).
