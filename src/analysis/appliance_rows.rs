@@ -1,14 +1,17 @@
 //! `orthosim validate`'s archwire rows: the rod model ([`crate::appliance::Rod`]) in the bench
 //! tests that wire properties are published from.
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
 use super::{
     AnalysisError,
     biomechanics::{ValidationRow, bare_case1, tooth},
 };
 use crate::{
-    appliance::{Holder, Reaction, Rod, Settings, WireMaterial, WireSize, coil::CoilKind},
+    appliance::{
+        Bracket, Holder, Reaction, Rod, Settings, Slot, WireMaterial, WireSize, coil::CoilKind,
+        torque_play_rad,
+    },
     collision::{Method, collision_shapes},
     movement::{MovementModel, MovementSettings, RunLimit, Simulation, WireChoice, run_case_for},
     sphere_tree::{TreeMethod, TreeSettings},
@@ -67,6 +70,73 @@ pub fn niti_unloading_force() -> f64 {
     bend_through(&mut rod, &[0.5, 1.0, 1.5, 2.0, 2.5, 3.1, 2.5, 2.0])
         .and_then(|f| f.last().copied())
         .unwrap_or(f64::NAN)
+}
+
+/// The torque play of a rectangular wire in a slot (degrees, one way from centred), as a slot's
+/// holder gives it ([`torque_play_rad`]: the wire's bevelled corners against the slot's walls).
+pub fn torque_play_deg(size: WireSize, slot: Slot) -> f64 {
+    torque_play_rad(size, slot).map_or(f64::NAN, f64::to_degrees)
+}
+
+/// Where [`torque_rig`] twists the wire: at grips this far either side of the bracket (mm), an
+/// interbracket span.
+pub const TORQUE_GRIP_MM: f64 = 7.0;
+
+/// A torque rig as Meling et al. built theirs: a straight wire of `size` and `material` through
+/// one bracket with a `slot` (its slot square to the wire), gripped [`TORQUE_GRIP_MM`] either
+/// side and twisted there about its own axis in steps of 0.25°. The twist (degrees) at which the
+/// bracket first holds `onset_nmm`, and at which it holds `moment_nmm`; NaN for what it never
+/// reaches by 60° or when a solve does not converge.
+pub fn torque_rig(
+    size: WireSize,
+    material: WireMaterial,
+    slot: Slot,
+    onset_nmm: f64,
+    moment_nmm: f64,
+) -> (f64, f64) {
+    let mut rod = straight(2.0 * TORQUE_GRIP_MM, 28, size, material);
+    let last = rod.nodes.len() - 1;
+    let middle = last / 2;
+    let rest = rod.nodes.clone();
+    let bracket = Bracket {
+        slot,
+        width_mm: 3.0,
+        centre: rest[middle].x,
+        frame: rest[middle].q,
+    };
+    let held = bracket.holder(middle, DQuat::IDENTITY, DVec3::ZERO, size);
+    let (mut onset, mut reached) = (f64::NAN, f64::NAN);
+    let mut before = (0.0, 0.0);
+    let step = 0.25f64;
+    for k in 1..=240 {
+        let twist = step * k as f64;
+        let turn = DQuat::from_rotation_x(twist.to_radians());
+        let grip = |node: usize| {
+            let mut h = Holder::clamp(node, &rest[node]);
+            h.frame = turn * rest[node].q;
+            h
+        };
+        let mut right = grip(last);
+        right.play[0] = f64::INFINITY;
+        let holders = [grip(0), right, held];
+        if !rod.solve(&holders, &[], &Settings::default()).converged {
+            return (f64::NAN, f64::NAN);
+        }
+        let m = rod.reactions(&holders)[2].moment.x.abs();
+        let cross = |target: f64| {
+            let (t0, m0) = before;
+            t0 + (twist - t0) * (target - m0) / (m - m0).max(1e-12)
+        };
+        if onset.is_nan() && m >= onset_nmm {
+            onset = cross(onset_nmm);
+        }
+        if m >= moment_nmm {
+            reached = cross(moment_nmm);
+            break;
+        }
+        before = (twist, m);
+    }
+    (onset, reached)
 }
 
 /// The built-in `crowded` case run for up to 240 clinical days with its wire sequence as
@@ -190,6 +260,40 @@ pub fn rows(settings: &MovementSettings) -> Result<Vec<ValidationRow>, AnalysisE
             source: "elastomeric chain at a fixed stretch: 37–75 % of its force lost by day 21 (Buchmann et al., Angle Orthod 2012;82:529–35)",
         },
         ValidationRow {
+            name: "torque_play_deg",
+            tooth: 0,
+            mf: None,
+            value: torque_play_deg(WireSize::Rect(0.019, 0.025), Slot::S022),
+            unit: "°",
+            reference: Some([5.0, 15.0]),
+            source: "0.019×0.025\" in a 0.022\" slot: engagement angle about 7.5° (active) to 14° (passive self-ligating) (Archambault et al., Angle Orthod 2010, systematic review); bevels 7 % of the area (Rucker & Kusy 2002)",
+        },
+        ValidationRow {
+            name: "torque_play_deg",
+            tooth: 0,
+            mf: None,
+            value: torque_play_deg(WireSize::Rect(0.016, 0.022), Slot::S018),
+            unit: "°",
+            reference: Some([15.0, 22.0]),
+            source: "0.016×0.022\" in a 0.018\" slot: 18.5° mean, 16.6–20.4° (Meling et al., AJODO 1997;111:310–20); the slot at the 0.0188\" such slots measure (Meling et al., AJODO 1998;113:387–93)",
+        },
+        ValidationRow {
+            name: "twist_for_20nmm_deg",
+            tooth: 0,
+            mf: None,
+            value: torque_rig(
+                WireSize::Rect(0.016, 0.022),
+                WireMaterial::StainlessSteel,
+                Slot::S018,
+                0.5,
+                20.0,
+            )
+            .1,
+            unit: "°",
+            reference: Some([22.0, 32.0]),
+            source: "0.016×0.022\" steel in a 0.018\" slot: 24.6–29.2° of twist to reach 20 N·mm (Meling et al., AJODO 1997;111:310–20); twisted at grips 7 mm either side of the bracket",
+        },
+        ValidationRow {
             name: "sliding_force_loss",
             tooth: 13,
             mf: None,
@@ -225,6 +329,43 @@ mod tests {
                 r.reference
             );
         }
+    }
+
+    #[test]
+    fn the_torque_rig_engages_at_the_slots_play_and_twists_the_wire_beyond() {
+        for (size, slot) in [
+            (WireSize::Rect(0.016, 0.022), Slot::S018),
+            (WireSize::Rect(0.019, 0.025), Slot::S022),
+        ] {
+            let play = torque_play_deg(size, slot);
+            let (onset, at20) = torque_rig(size, WireMaterial::StainlessSteel, slot, 0.5, 20.0);
+            // The slot bears where its geometry says (the wall's blend and the grips' twist of
+            // the wire under half a newton-millimetre add a fraction of a degree).
+            assert!(
+                onset >= play && onset < play + 1.0,
+                "{onset}° against {play}°"
+            );
+            // Beyond it, the wire's own twist over the grips' span and the walls' give.
+            let k = WireSize::properties(size).torsion * WireMaterial::StainlessSteel.shear();
+            let wire_only = (10.0 * TORQUE_GRIP_MM / k).to_degrees();
+            assert!(
+                at20 > play + wire_only,
+                "{at20}° against {play}° + {wire_only}°"
+            );
+            assert!(at20 < play + 2.0 * wire_only + 5.0, "{at20}°");
+            // TMA twists further for the same moment (a third of steel's shear modulus).
+            let (_, tma) = torque_rig(size, WireMaterial::Tma, slot, 0.5, 20.0);
+            assert!(tma > at20 + wire_only, "{tma}° against {at20}°");
+        }
+        // A round wire never engages.
+        let (onset, _) = torque_rig(
+            WireSize::Round(0.018),
+            WireMaterial::StainlessSteel,
+            Slot::S022,
+            0.5,
+            20.0,
+        );
+        assert!(onset.is_nan(), "{onset}");
     }
 
     #[test]

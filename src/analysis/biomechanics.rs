@@ -17,6 +17,9 @@
 //! | `wire_three_point_stiffness_n_per_mm` | the archwire rod, 0.016" steel, centre-loaded on a 10 mm span | 48EI/L³ ± 10 % ([`super::appliance_rows`]) |
 //! | `niti_unloading_force_n` | the rod, 0.016" NiTi, three-bracket test (7 mm spans) unloading at 2 mm after 3.1 mm | 0.8–1.8 N (Materials Research 2015: 98–151 gf) |
 //! | `chain_force_fraction_day21` | the elastomeric chain's decay at a fixed stretch ([`crate::appliance::chain`]) | 0.25–0.65 (Buchmann 2012: 37–75 % lost) |
+//! | `power_arm_bodily_mm` | upper central incisor retracted lingually by a force hooked on a power arm along its long axis from the bracket (0.019×0.025" wire in a 0.022" slot, free within its torque play): the arm's length at which it moves bodily | 9–14 mm (Tominaga et al. 2014: 11.6 mm) |
+//! | `torque_play_deg` | the torque play of 0.019×0.025" in a 0.022" slot, and of 0.016×0.022" in a 0.018" slot, from the bevelled wire's corners and the slot's measured height ([`crate::appliance::torque_play_rad`]) | 5–15° (Archambault et al. 2010); 15–22° (Meling et al. 1997: 16.6–20.4°) |
+//! | `twist_for_20nmm_deg` | 0.016×0.022" steel through a 0.018" bracket, twisted at grips 7 mm either side: the twist at which the bracket holds 20 N·mm ([`super::appliance_rows::torque_rig`]) | 22–32° (Meling et al. 1997: 24.6–29.2°) |
 //! | `sliding_force_loss` | case 1's upper canine retracted along 0.016" steel (0.022" slots, elastomeric modules, μ 0.2) by a 2 N closed coil: share of the pull the slot's friction takes, days 7–60 | 0.4–0.85 (Kojima & Fukui 2005, finite elements: about 70 %) |
 //! | `crowded_alignment_days` | the `crowded` case with its wire sequence, as `simulate --algorithm exact` runs it: first day the lower Little index is under 1 mm | 60–240 days (clinical trials) |
 //!
@@ -127,6 +130,35 @@ fn crot(g: &ToothGeometry, p: &PdlStiffness, mf: f64) -> (Option<f64>, f64) {
         PdlStiffness::centre_of_rotation_along_axis(&t, a.axis),
         halves(&t).1.dot(tip),
     )
+}
+
+/// The tipping rotation (radians) of a tooth retracted lingually by 1 N hooked on a power arm
+/// `arm` mm long, bonded at the bracket and reaching along the long axis towards the apex.
+fn power_arm_tip(g: &ToothGeometry, p: &PdlStiffness, arm: f64) -> f64 {
+    let a = axes(g);
+    let c = p.centre_of_resistance.as_dvec3();
+    let hook = p.bracket.as_dvec3() - a.axis * arm;
+    let t = p
+        .compliance
+        .mul_vec(&wrench(a.lingual, hook, DVec3::ZERO, c));
+    halves(&t).1.dot(a.axis.cross(a.lingual).normalize())
+}
+
+/// The power arm (mm) on which an upper central incisor's retraction is bodily, its
+/// 0.019×0.025" wire in a 0.022" slot: the wire leaves the tooth free within its torque play
+/// (NaN when the wire would take up the tipping instead), so the ligament decides where the
+/// force's line must pass.
+fn power_arm_bodily_mm(g: &ToothGeometry, p: &PdlStiffness) -> f64 {
+    let play = crate::appliance::torque_play_rad(
+        crate::appliance::WireSize::Rect(0.019, 0.025),
+        crate::appliance::Slot::S022,
+    );
+    if play.is_none_or(|v| v <= 0.0) {
+        return f64::NAN;
+    }
+    // The tipping is linear in the arm's length: zero where the arm's couple meets the force's.
+    let (r0, r1) = (power_arm_tip(g, p, 0.0), power_arm_tip(g, p, 1.0));
+    r0 / (r0 - r1)
 }
 
 fn geometry(
@@ -280,6 +312,15 @@ pub fn validate(
         unit: "mm",
         reference: Some([0.6, 0.8]),
         source: "0.71 mm/month at 100 g, maxilla (Monini et al., Angle Orthod 2019;89:559); β is calibrated on it; ±0.1 mm",
+    });
+    rows.push(ValidationRow {
+        name: "power_arm_bodily_mm",
+        tooth: 11,
+        mf: None,
+        value: power_arm_bodily_mm(&g11, &p11),
+        unit: "mm",
+        reference: Some([9.0, 14.0]),
+        source: "power arm for bodily retraction of the upper incisors: 11.6 mm on 0.019×0.025\" in 0.022\" slots, 9.1 mm on 0.017×0.022\" in 0.018\" (Tominaga et al., AJODO 2014;146:166–74, finite elements); the arm along the long axis from the bracket, the wire free within its 14.9° torque play",
     });
     rows.extend(super::appliance_rows::rows(settings)?);
     Ok(Validation {

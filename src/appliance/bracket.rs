@@ -14,7 +14,12 @@
 //! ([`torque_play_rad`], one way from centred: the geometric engagement angle of a wire with
 //! [`super::section::WireSize::bevel_mm`] corners). Angled in the slot's plane, a wire binds at
 //! Kusy's critical contact angle (S − h)/W for a bracket W wide ([`binding_angle_rad`]). Slots
-//! are taken at their nominal sizes (real slots measure up to about 10 % larger, which adds play).
+//! are taken at the heights they are made to, not their names: Meling et al. (AJODO
+//! 1998;113:387–93) measured "0.018"" slots at 0.0185–0.0189" (brand means), so 0.018" slots are
+//! 0.0188" here; 0.022" slots are taken at their nominal height (orthosim has no measurement of
+//! them). The torque play follows: 15.4° for 0.016×0.022" in a 0.018" slot (Meling et al. 1997
+//! measured 16.6–20.4°) and 14.9° for 0.019×0.025" in a 0.022" slot (about 14° in passive
+//! self-ligating brackets, Archambault et al. 2010); `orthosim validate` checks both.
 
 pub use crate::teeth::case::appliance::Slot;
 use glam::{DQuat, DVec3};
@@ -31,10 +36,10 @@ pub const BASE_MM: f64 = 0.8;
 pub const WALL_N_PER_MM: f64 = 2.0e3;
 
 impl Slot {
-    /// Height (mm): what the wire's height fits into.
+    /// Height (mm) as made: what the wire's height fits into (see the module's doc).
     pub fn height_mm(self) -> f64 {
         match self {
-            Self::S018 => 0.018 * MM_PER_INCH,
+            Self::S018 => 0.0188 * MM_PER_INCH,
             Self::S022 => 0.022 * MM_PER_INCH,
         }
     }

@@ -566,7 +566,17 @@ fn simulate_takes_either_model_and_validate_prints_its_rows() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["model"], "pdl");
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 21);
+    assert_eq!(rows.len(), 25);
+    for name in [
+        "torque_play_deg",
+        "twist_for_20nmm_deg",
+        "power_arm_bodily_mm",
+    ] {
+        assert!(
+            rows.iter().any(|r| r["name"] == name && r["unit"] != ""),
+            "{name}"
+        );
+    }
     assert!(
         rows.iter()
             .any(|r| r["name"] == "niti_unloading_force_n" && r["tooth"] == 0)
@@ -709,7 +719,7 @@ fn report_writes_every_file_its_page_refers_to() {
     }
     assert_eq!(
         v["biomechanics"]["rows"].as_array().map(|r| r.len()),
-        Some(21)
+        Some(25)
     );
     assert!(html.contains("The bite") && html.contains("biomechanics"));
     let fit = v["tree_fit"].as_array().unwrap();

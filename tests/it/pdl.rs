@@ -28,6 +28,9 @@ fn every_validation_row_is_inside_its_reference() {
     assert_eq!(teeth("sigma2_over_root_length2"), [11]);
     assert_eq!(teeth("crown_displacement_mm_5n"), [12]);
     assert_eq!(teeth("canine_retraction_mm_per_month_1n"), [13]);
+    assert_eq!(teeth("power_arm_bodily_mm"), [11]);
+    assert_eq!(teeth("torque_play_deg"), [0, 0]);
+    assert_eq!(teeth("twist_for_20nmm_deg"), [0]);
     let crot = rows("crot_from_cres_mm");
     let mfs: Vec<f32> = crot.iter().map(|r| r.mf.unwrap()).collect();
     assert_eq!(mfs, [0.0, 2.0, 4.0, 6.0, 8.0, 12.0]);
@@ -53,6 +56,14 @@ fn every_validation_row_is_inside_its_reference() {
     let d = rows("bracket_to_cres_mm")[0].value;
     let translation = rows("mf_translation")[0].value;
     assert!((translation - d).abs() < 1.0, "{translation} vs d {d}");
+    // A power arm's force is the bracket's force and the couple of the arm: the arm for bodily
+    // retraction is the M/F that translates (the wire free within its torque play).
+    let arm = rows("power_arm_bodily_mm")[0].value;
+    assert!((arm - translation).abs() < 1e-6, "{arm} vs {translation}");
+    // The fuller wire in the smaller slot plays more (the slot's measured height, the bevels).
+    let play: Vec<f64> = rows("torque_play_deg").iter().map(|r| r.value).collect();
+    assert!(play[0] < play[1], "{play:?}");
+    assert!(rows("twist_for_20nmm_deg")[0].value > play[1] + 5.0);
 }
 
 /// Case 1's arrangement with its loads and constraints removed and 1 N distal on the upper right
