@@ -78,7 +78,7 @@ pub struct PlateContact {
 
 /// One arch's axis in plan.
 #[derive(Clone, Debug)]
-struct Axis {
+pub(crate) struct Axis {
     arch: Arch,
     /// The axis in plan (x, z), right distal to left distal.
     path: Vec<Vec2>,
@@ -86,7 +86,7 @@ struct Axis {
 
 impl Axis {
     /// The axis along `curve` from the right end of its tail to the left one.
-    fn along(arch: Arch, curve: &ArchCurve) -> Self {
+    pub(crate) fn along(arch: Arch, curve: &ArchCurve) -> Self {
         let end = curve.half_length() + TAIL_MM;
         let n = ((2.0 * end / AXIS_STEP_MM).ceil() as usize).max(1);
         let path = (0..=n)
@@ -97,7 +97,7 @@ impl Axis {
 
     /// Signed offset (positive buccal) and outward unit normal of plan point `p`: the nearest
     /// of every [`COARSE`]th vertex, then the segments either side of it.
-    fn locate(&self, p: Vec2) -> (f32, Vec2) {
+    pub(crate) fn locate(&self, p: Vec2) -> (f32, Vec2) {
         let last = self.path.len() - 1;
         let near = (0..=last)
             .step_by(COARSE)

@@ -10,6 +10,7 @@ pub mod archwire;
 pub mod banded;
 pub mod bench;
 pub mod bone;
+pub mod bone_mesh;
 pub mod bracket;
 pub mod chain;
 pub mod coil;

@@ -202,6 +202,15 @@ pub fn closest_point_and_triangle(m: MeshRef, p: Vec3) -> Option<(Vec3, f32, u32
     closest_on_mesh_within(m, p, f32::INFINITY)
 }
 
+/// [`closest_point_on_mesh_within`] with the number of the triangle the point lies on. Exact.
+pub fn closest_point_and_triangle_within(
+    m: MeshRef,
+    p: Vec3,
+    limit: f32,
+) -> Option<(Vec3, f32, u32)> {
+    closest_on_mesh_within(m, p, limit)
+}
+
 /// [`closest_point_on_mesh_within`] with the number of the triangle the point lies on.
 fn closest_on_mesh_within(m: MeshRef, p: Vec3, limit: f32) -> Option<(Vec3, f32, u32)> {
     let mut best: Option<(Vec3, f32, u32)> = None;

@@ -37,9 +37,9 @@ pub use crossing::crossing_triangles;
 pub use mass::{MassProperties, jacobi_eigen, symmetric_eigen};
 pub use mat6::{Mat6, Vec6, halves, vec6};
 pub use mesh_distance::{
-    MeshRef, MeshSeparation, closest_point_and_triangle, closest_point_on_mesh,
-    closest_point_on_mesh_within, closest_triangles, mesh_penetration, mesh_separation,
-    mesh_separation_within, point_inside_mesh,
+    MeshRef, MeshSeparation, closest_point_and_triangle, closest_point_and_triangle_within,
+    closest_point_on_mesh, closest_point_on_mesh_within, closest_triangles, mesh_penetration,
+    mesh_separation, mesh_separation_within, point_inside_mesh,
 };
 pub use pose::Pose;
 pub use section::section_loops;

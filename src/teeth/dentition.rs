@@ -10,13 +10,13 @@ use super::{
         ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces,
         irregularity::{Anterior, ContactPoints},
     },
-    case::{CaseError, CaseVector, LoadedCase, WireModel},
+    case::{Case, CaseError, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
     import::Repairs,
     patient::{OrientationReport, patient_teeth},
     tooth_shape::{ShapeSet, ToothGeometry},
 };
-use crate::geometry::Pose;
+use crate::geometry::{Pose, TriMesh};
 
 /// One tooth of a case, placed in the world frame.
 #[derive(Clone, Debug)]
@@ -111,6 +111,9 @@ pub struct Dentition {
     pub imported: std::collections::BTreeMap<Fdi, Repairs>,
     /// Where the case's mesh and scan files were placed.
     pub orientation: Vec<OrientationReport>,
+    /// The case's bone meshes (upper, lower) where it names them, in place (the maxilla raised
+    /// with the upper teeth by the bite's opening).
+    pub bone: [Option<Arc<TriMesh>>; 2],
     /// What the import of each labelled scan changed in its labels or left out.
     pub scans: Vec<super::patient::ScanReport>,
 }
@@ -244,6 +247,7 @@ impl Dentition {
                 }
             }
         }
+        let bone = read_bones(&loaded, &orientation, lift)?;
         Ok(Self {
             case: Arc::new(loaded),
             teeth,
@@ -253,6 +257,7 @@ impl Dentition {
             contact_points,
             setup,
             imported: imported_repairs,
+            bone,
             orientation,
             scans,
         })
@@ -294,4 +299,37 @@ fn fitted_forms(teeth: &[PlacedTooth], start: [BetaArch; 2]) -> [BetaArch; 2] {
         form.fit(&points)
     };
     [fit(Arch::Upper, start[0]), fit(Arch::Lower, start[1])]
+}
+
+/// The case's bone meshes, read and placed: `Auto` as the case's automatically placed files
+/// (the file's own frame without any), the maxilla raised by the bite's opening `lift`.
+fn read_bones(
+    loaded: &LoadedCase,
+    orientation: &[OrientationReport],
+    lift: Vec3,
+) -> Result<[Option<Arc<TriMesh>>; 2], CaseError> {
+    let bone = &loaded.case.bone;
+    let auto = orientation
+        .iter()
+        .find(|r| r.auto)
+        .map_or(Pose::IDENTITY, |r| r.pose);
+    let read = |spec: &Option<crate::teeth::import::ToothMeshFile>,
+                raise: Vec3|
+     -> Result<Option<Arc<TriMesh>>, CaseError> {
+        let Some(spec) = spec else {
+            return Ok(None);
+        };
+        let path = Case::mesh_path(&loaded.origin, &spec.file);
+        let mesh =
+            crate::teeth::import::read_bone(&path, spec.units).map_err(|e| CaseError::Scan {
+                path: path.display().to_string(),
+                case: loaded.origin.clone(),
+                message: e.to_string(),
+            })?;
+        let pose = spec.transform.pose().unwrap_or(auto);
+        Ok(Some(Arc::new(
+            mesh.map_vertices(|v| pose.transform_point(v) + raise),
+        )))
+    };
+    Ok([read(&bone.upper, lift)?, read(&bone.lower, Vec3::ZERO)?])
 }

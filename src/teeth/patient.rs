@@ -38,6 +38,9 @@ pub struct OrientationReport {
     /// from the arrangement's.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rms_mm: Option<f32>,
+    /// The placement itself, from the files' frame (mm) to orthosim's.
+    #[serde(skip)]
+    pub pose: Pose,
 }
 
 /// What the import of a labelled scan changed in its labels, and the labels it left out.
@@ -151,6 +154,7 @@ pub(super) fn patient_teeth(
             translation,
             auto: true,
             rms_mm: Some(found.rms_mm),
+            pose: found.pose,
         });
     }
     for (i, s) in sources.iter().enumerate() {
@@ -171,6 +175,7 @@ pub(super) fn patient_teeth(
             translation,
             auto: false,
             rms_mm: None,
+            pose,
         });
     }
     // The label fixes' places, from the scans' frames (mm) to orthosim's.

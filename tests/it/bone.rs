@@ -141,3 +141,128 @@ fn simulate_reports_a_root_at_a_plate_in_its_table_and_json() {
     assert!(first["depth_mm"].as_f64().unwrap() < 0.05, "{first}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A closed box, its faces wound outwards.
+fn closed_box(lo: glam::Vec3, hi: glam::Vec3) -> orthosim::geometry::TriMesh {
+    let v: Vec<glam::Vec3> = (0..8)
+        .map(|k| {
+            glam::Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let triangles = quads
+        .iter()
+        .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
+        .collect();
+    orthosim::geometry::TriMesh::new(v, triangles)
+}
+
+/// World positions of tooth `i`'s root samples.
+fn roots_of(sim: &Simulation, i: usize) -> Vec<glam::Vec3> {
+    let t = &sim.teeth[i];
+    let p = t.pdl.as_ref().unwrap();
+    p.root_samples
+        .iter()
+        .map(|r| t.pose.transform_point(*r))
+        .collect()
+}
+
+#[test]
+fn a_bone_mesh_named_by_the_case_holds_the_roots_it_covers_and_an_open_one_is_refused() {
+    // Where the lower roots stand, from the same case with the envelope, in 41's frame as
+    // placed (z labial, y along its long axis).
+    let mut envelope = pushed(41, "Anatomical(buccal: -1.0)", true);
+    let i = envelope.index_of(Fdi::new(41).unwrap()).unwrap();
+    let frame = envelope.teeth[i].pose;
+    let local = |p: glam::Vec3| frame.inverse().transform_point(p);
+    let (mut lo, mut hi) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
+    for (k, t) in envelope.teeth.iter().enumerate() {
+        if t.fdi.arch() == orthosim::teeth::Arch::Lower && t.pdl.is_some() {
+            for p in roots_of(&envelope, k) {
+                (lo, hi) = (lo.min(local(p)), hi.max(local(p)));
+            }
+        }
+    }
+    // A mandible whose labial wall runs along 41's root 0.3 mm before it, everything else far
+    // off (the crest well above the roots: it holds nothing anyway).
+    let labial = |sim: &Simulation| {
+        roots_of(sim, i)
+            .iter()
+            .map(|p| local(*p).z)
+            .fold(f32::MIN, f32::max)
+    };
+    let front = labial(&envelope) + 0.3;
+    let mandible = closed_box(
+        lo - glam::Vec3::splat(5.0),
+        glam::Vec3::new(hi.x + 5.0, hi.y + 5.0, front),
+    )
+    .map_vertices(|v| frame.transform_point(v));
+    let dir = std::env::temp_dir().join(format!("orthosim-bone-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, m: &orthosim::geometry::TriMesh| {
+        let mut f = std::fs::File::create(dir.join(name)).unwrap();
+        orthosim::teeth::import::write_stl(m, &mut f).unwrap();
+    };
+    write("mandible.stl", &mandible);
+    let case = |file: &str| {
+        format!(
+            "Case(name: \"bone\", teeth: All, loads: [(teeth: [41], force: Anatomical(buccal: \
+             -1.0))], wire: (upper: Round, lower: Round), bone: (lower: Some((file: \"{file}\", \
+             transform: Identity))))"
+        )
+    };
+    let path = dir.join("case.ron").display().to_string();
+    let d = Dentition::build(Case::parse(&case("mandible.stl"), &path).unwrap()).unwrap();
+    assert!(d.bone[1].is_some() && d.bone[0].is_none());
+    let shapes = collision_shapes(&d, TreeSettings::with_method(TreeMethod::Octree), None).unwrap();
+    let mut sim = Simulation::new(&d, shapes, Method::Exact, MovementSettings::default()).unwrap();
+    let meshes = sim
+        .bone_meshes
+        .as_ref()
+        .expect("the mandible holds the lower teeth");
+    assert!(meshes.holds(Fdi::new(41).unwrap()) && !meshes.holds(Fdi::new(11).unwrap()));
+    let mut worst = f32::NEG_INFINITY;
+    for _ in 0..180 {
+        sim.step();
+        envelope.step();
+        worst = worst.max(labial(&sim) - front);
+    }
+    // The root reached the mesh's labial wall, was held there and recorded.
+    assert!(
+        worst > -0.05 && worst < 0.05,
+        "41's root {worst} mm past the wall"
+    );
+    assert!(
+        sim.cortical
+            .iter()
+            .any(|c| c.fdi.to_string() == "41"
+                && c.plate == orthosim::appliance::bone::Plate::Buccal),
+        "{:?}",
+        sim.cortical
+    );
+    // The envelope's plate, a millimetre beyond the roots and their neighbours', let it farther.
+    let free = labial(&envelope);
+    assert!(free - front > 0.2, "{free} against the wall at {front}");
+    // A mesh with a hole is refused, naming the file and where.
+    let mut open = mandible.clone();
+    open.triangles.pop();
+    write("open.stl", &open);
+    let e = Dentition::build(Case::parse(&case("open.stl"), &path).unwrap()).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        message.contains("open.stl") && message.contains("open: 3 edges"),
+        "{message}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

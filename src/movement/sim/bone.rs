@@ -1,4 +1,5 @@
-//! The alveolar bone in the PDL step: the cortical plates of [`crate::appliance::bone`] as
+//! The alveolar bone in the PDL step: the cortical plates of [`crate::appliance::bone`] (or,
+//! for the teeth a case's bone meshes cover, the walls of [`crate::appliance::bone_mesh`]) as
 //! contacts with a body that never moves.
 //!
 //! The envelope is made from the teeth's initial poses and the case's extraction sites when the
@@ -21,7 +22,10 @@ use serde::Serialize;
 
 use super::Simulation;
 use crate::{
-    appliance::bone::{AlveolarEnvelope, Plate, RootedTooth},
+    appliance::{
+        bone::{AlveolarEnvelope, Plate, RootedTooth},
+        bone_mesh::BoneMeshes,
+    },
     geometry::Pose,
     movement::pdl::ContactRow,
     teeth::Fdi,
@@ -78,10 +82,9 @@ impl Simulation {
                 roots,
             }))
             .collect();
-        self.bone = Some(AlveolarEnvelope::new(
-            &rooted,
-            [&self.curves[0], &self.curves[1]],
-        ));
+        let curves = [&self.curves[0], &self.curves[1]];
+        self.bone_meshes = BoneMeshes::new(&self.bone_files, &rooted, curves);
+        self.bone = Some(AlveolarEnvelope::new(&rooted, curves));
     }
 
     /// Makes the envelope when the PDL model starts without one (its settings changed to it).
@@ -97,6 +100,7 @@ impl Simulation {
         let Some(bone) = &self.bone else {
             return Vec::new();
         };
+        let meshes = self.bone_meshes.as_ref();
         let mut rows = Vec::new();
         let mut reached = Vec::new();
         for (u, group) in members.iter().enumerate() {
@@ -105,7 +109,10 @@ impl Simulation {
                 let Some(p) = t.pdl.as_ref() else {
                     continue;
                 };
-                let mut found = bone.contacts(t.fdi, &t.pose, &p.root_samples, LOOKAHEAD_MM);
+                let mut found = match meshes.filter(|m| m.holds(t.fdi)) {
+                    Some(m) => m.contacts(t.fdi, &t.pose, &p.root_samples, LOOKAHEAD_MM),
+                    None => bone.contacts(t.fdi, &t.pose, &p.root_samples, LOOKAHEAD_MM),
+                };
                 found.sort_by(|a, b| b.depth.total_cmp(&a.depth));
                 found.truncate(MOST_PER_TOOTH);
                 for c in &found {

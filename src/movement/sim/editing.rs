@@ -166,6 +166,8 @@ impl Simulation {
             contact_points: d.contact_points.clone(),
             setup: d.setup.clone(),
             bone: None,
+            bone_files: d.bone.clone(),
+            bone_meshes: None,
             cortical: Vec::new(),
         };
         if settings.model == MovementModel::Pdl {
@@ -376,6 +378,7 @@ impl Simulation {
         next.total_energy_lost_uj = self.total_energy_lost_uj;
         next.elapsed_days = self.elapsed_days;
         next.bone = self.bone.clone();
+        next.bone_meshes = self.bone_meshes.clone();
         next.cortical = self.cortical.clone();
         // The wires are laid again through the brackets left (as a wire is engaged afresh
         // after an extraction).

@@ -282,6 +282,10 @@ pub struct Simulation {
     pub setup: BTreeMap<Fdi, crate::geometry::Pose>,
     /// The alveolar envelope whose cortical plates hold the roots (made at the first PDL step).
     pub bone: Option<crate::appliance::AlveolarEnvelope>,
+    /// The case's bone meshes (upper, lower), as the dentition places them.
+    pub bone_files: [Option<std::sync::Arc<crate::geometry::TriMesh>>; 2],
+    /// The bone meshes' hold on the roots they cover, in place of the envelope's (made with it).
+    pub bone_meshes: Option<crate::appliance::bone_mesh::BoneMeshes>,
     /// Every root that reached a cortical plate, in the order they did.
     pub cortical: Vec<CorticalContact>,
 }

@@ -14,7 +14,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use parts::{
-    CaseConstraint, CaseLoad, CaseOffset, CaseVector, CaseWires, Freedoms, PresentTeeth, WireModel,
+    CaseBone, CaseConstraint, CaseLoad, CaseOffset, CaseVector, CaseWires, Freedoms, PresentTeeth,
+    WireModel,
 };
 pub use values::{Finite, NonNegative, ToothList, ToothMap};
 
@@ -156,6 +157,9 @@ pub struct Case {
     /// labelled tooth becomes a scanned crown; see [`crate::teeth::import::ScanFile`].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub scans: Vec<crate::teeth::import::ScanFile>,
+    /// Bone meshes, e.g. `(lower: Some((file: "mandible.stl")))`; see [`CaseBone`].
+    #[serde(default, skip_serializing_if = "CaseBone::is_empty")]
+    pub bone: CaseBone,
 }
 
 /// A case with where it came from.

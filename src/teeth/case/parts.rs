@@ -166,3 +166,26 @@ pub enum PresentTeeth {
     /// All but these.
     AllBut(ToothList),
 }
+
+/// Bone meshes per arch, as CBCT segmentations give the maxilla and the mandible: closed
+/// surfaces whose inside is bone, each a file like a tooth's in `meshes` (path relative to the
+/// case file, units, transform; `Auto` takes the placement found for the case's other
+/// automatically placed files, or the file's own frame without any). A root stays inside its
+/// arch's bone where the segmentation covers it; an arch without one keeps the alveolar envelope.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseBone {
+    /// The maxilla.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper: Option<crate::teeth::import::ToothMeshFile>,
+    /// The mandible.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lower: Option<crate::teeth::import::ToothMeshFile>,
+}
+
+impl CaseBone {
+    /// True when the case names no bone mesh.
+    pub fn is_empty(&self) -> bool {
+        self.upper.is_none() && self.lower.is_none()
+    }
+}

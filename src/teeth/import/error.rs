@@ -33,6 +33,17 @@ pub enum ImportError {
     /// The file has no bytes.
     #[error("the file is empty")]
     EmptyFile,
+    /// A bone mesh with holes (a bone mesh must be a closed surface).
+    #[error(
+        "the bone mesh is open: {edges} edges bound its holes, the first at ({:.2}, {:.2}, {:.2}) mm; a bone mesh must be a closed surface",
+        at[0], at[1], at[2]
+    )]
+    OpenBone {
+        /// Edges used by one triangle only.
+        edges: usize,
+        /// A vertex of the first of them (mm, the file's frame).
+        at: [f32; 3],
+    },
     /// The file is not valid in its format (the parser's words, on one line).
     #[error("not a valid {format} file: {detail}")]
     Malformed {

@@ -30,6 +30,7 @@
 //! ones; the tooth stands exactly where the scan has it (its pose maps the local mesh back).
 
 pub mod apart;
+mod bone;
 mod close;
 mod error;
 mod export;
@@ -59,6 +60,7 @@ use super::{
 };
 use crate::geometry::{MassProperties, Pose, TriMesh};
 
+pub use bone::read_bone;
 pub use error::{ImportError, Near, PlyProblem};
 pub use export::{
     ExportMeshes, ExportReport, export_case, export_case_as, export_labelled_scans,
