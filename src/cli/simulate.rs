@@ -236,6 +236,22 @@ fn print_table(r: &SimulationReport) {
     for (pair, mm) in &r.ipr_mm {
         println!("IPR {pair}: {mm:.3} mm");
     }
+    if let Some(b) = &r.bone_meshes {
+        let outside: Vec<String> = b
+            .outside
+            .iter()
+            .map(|o| format!("{} {}/{}", o.fdi, o.points, o.of))
+            .collect();
+        println!(
+            "bone meshes hold {} teeth; root points outside the bone as placed (not held): {}",
+            b.teeth.len(),
+            if outside.is_empty() {
+                "none".to_owned()
+            } else {
+                outside.join(", ")
+            }
+        );
+    }
     for c in &r.cortical_contacts {
         println!(
             "root of {} at the {} plate from day {:.0} to day {:.0} (deepest {:.3} mm past it)",

@@ -27,9 +27,9 @@ pub use plugin::{
     SetLoad, SetMomentToForce, SetWire, SimulationState, ToothImpact,
 };
 pub use report::{
-    ApplianceReport, BracketReport, CaseRun, ChainReport, CoilReport, Irregularity, MOVED_MM,
-    PairDistance, RunLimit, SimulationReport, ToothTravel, WireReport, max_penetration,
-    neighbour_pairs, pair_distances, run_case, run_case_for, tooth_travel,
+    ApplianceReport, BoneMeshReport, BoneOutside, BracketReport, CaseRun, ChainReport, CoilReport,
+    Irregularity, MOVED_MM, PairDistance, RunLimit, SimulationReport, ToothTravel, WireReport,
+    max_penetration, neighbour_pairs, pair_distances, run_case, run_case_for, tooth_travel,
 };
 pub use settings::{MovementModel, MovementSettings, Response};
 pub use sim::{

@@ -118,6 +118,30 @@ pub struct SimulationReport {
     pub appliance: Option<ApplianceReport>,
     /// Every root that reached a cortical plate of the alveolar envelope (PDL model).
     pub cortical_contacts: Vec<CorticalContact>,
+    /// The case's bone meshes, when it names any (PDL model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bone_meshes: Option<BoneMeshReport>,
+}
+
+/// What a case's bone meshes hold.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoneMeshReport {
+    /// The teeth the meshes hold (the others keep the alveolar envelope).
+    pub teeth: Vec<Fdi>,
+    /// Held teeth with root points outside the bone as placed, which the mesh does not hold.
+    pub outside: Vec<BoneOutside>,
+}
+
+/// A tooth's root points outside its bone mesh as placed (a dehiscence, or a plate the
+/// segmentation thinned away).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoneOutside {
+    /// The tooth.
+    pub fdi: Fdi,
+    /// Root points outside the bone.
+    pub points: usize,
+    /// Root points sampled.
+    pub of: usize,
 }
 
 /// A wire as the report names it.
@@ -574,6 +598,17 @@ pub fn run_case_for(
         teeth: tooth_travel(&sim),
         appliance: appliance_report(&sim, collision_steps, wire_steps, converged, irregularity),
         cortical_contacts: sim.cortical.clone(),
+        bone_meshes: sim.bone_meshes.as_ref().map(|m| {
+            let held = m.uncovered();
+            BoneMeshReport {
+                teeth: held.iter().map(|h| h.0).collect(),
+                outside: held
+                    .iter()
+                    .filter(|h| h.1 > 0)
+                    .map(|&(fdi, points, of)| BoneOutside { fdi, points, of })
+                    .collect(),
+            }
+        }),
     };
     Ok(CaseRun {
         report,

@@ -254,6 +254,29 @@ fn a_bone_mesh_named_by_the_case_holds_the_roots_it_covers_and_an_open_one_is_re
     // The envelope's plate, a millimetre beyond the roots and their neighbours', let it farther.
     let free = labial(&envelope);
     assert!(free - front > 0.2, "{free} against the wall at {front}");
+    // `simulate`'s report names the teeth the mesh holds.
+    std::fs::write(dir.join("case.ron"), case("mandible.stl")).unwrap();
+    let run = orthosim::movement::run_case_for(
+        &path,
+        Method::Exact,
+        MovementSettings::default(),
+        TreeSettings::with_method(TreeMethod::Octree),
+        None,
+        orthosim::movement::RunLimit {
+            max_steps: u64::MAX,
+            max_days: Some(2.0),
+        },
+        |_| {},
+    )
+    .unwrap();
+    let report = run.report.bone_meshes.expect("the case names a mandible");
+    assert!(report.teeth.iter().any(|f| f.to_string() == "41"));
+    assert!(
+        report
+            .teeth
+            .iter()
+            .all(|f| f.arch() == orthosim::teeth::Arch::Lower)
+    );
     // A mesh with a hole is refused, naming the file and where.
     let mut open = mandible.clone();
     open.triangles.pop();
