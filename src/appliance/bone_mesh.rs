@@ -169,37 +169,11 @@ mod tests {
     use super::*;
     use crate::teeth::arch::ArchLayout;
 
-    /// A closed box, faces wound outwards.
-    fn closed_box(lo: Vec3, hi: Vec3) -> TriMesh {
-        let v = (0..8)
-            .map(|k| {
-                Vec3::new(
-                    if k & 1 == 0 { lo.x } else { hi.x },
-                    if k & 2 == 0 { lo.y } else { hi.y },
-                    if k & 4 == 0 { lo.z } else { hi.z },
-                )
-            })
-            .collect();
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let triangles = quads
-            .iter()
-            .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
-            .collect();
-        TriMesh::new(v, triangles)
-    }
-
     #[test]
     fn walls_hold_the_roots_they_cover_and_the_crest_and_missing_bone_do_not() {
         let curve = ArchCurve::new(&ArchLayout::default().lower);
         let zc = curve.at(0.0).0.y;
-        let mesh = Arc::new(closed_box(
+        let mesh = Arc::new(TriMesh::cuboid(
             Vec3::new(-10.0, -20.0, zc - 10.0),
             Vec3::new(10.0, 0.0, zc + 1.0),
         ));
@@ -246,7 +220,7 @@ mod tests {
             pose: Pose::IDENTITY,
             roots: &out,
         }];
-        let mesh = Arc::new(closed_box(Vec3::splat(-1.0), Vec3::splat(1.0)));
+        let mesh = Arc::new(TriMesh::cuboid(Vec3::splat(-1.0), Vec3::splat(1.0)));
         assert!(BoneMeshes::new(&[None, Some(mesh)], &stray, [&curve, &curve]).is_none());
     }
 }

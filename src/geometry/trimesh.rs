@@ -107,6 +107,34 @@ impl TriMesh {
         }
     }
 
+    /// An axis-aligned box from `min` to `max`: 8 vertices, 12 triangles wound outwards (a
+    /// closed solid for tests and rigs).
+    pub fn cuboid(min: Vec3, max: Vec3) -> Self {
+        let v = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 == 0 { min.x } else { max.x },
+                    if i & 2 == 0 { min.y } else { max.y },
+                    if i & 4 == 0 { min.z } else { max.z },
+                )
+            })
+            .collect();
+        // -z, +z, -y, +y, -x, +x.
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let t = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        Self::new(v, t)
+    }
+
     /// The three corners of triangle `i`.
     #[inline]
     pub fn triangle(&self, i: usize) -> [Vec3; 3] {
@@ -469,28 +497,7 @@ pub(crate) mod tests {
 
     /// An axis-aligned box from `min` to `max`, outward wound.
     pub(crate) fn cuboid(min: Vec3, max: Vec3) -> TriMesh {
-        let v = (0..8)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 == 0 { min.x } else { max.x },
-                    if i & 2 == 0 { min.y } else { max.y },
-                    if i & 4 == 0 { min.z } else { max.z },
-                )
-            })
-            .collect();
-        let quads = [
-            [0, 2, 3, 1], // -z
-            [4, 5, 7, 6], // +z
-            [0, 1, 5, 4], // -y
-            [2, 6, 7, 3], // +y
-            [0, 4, 6, 2], // -x
-            [1, 3, 7, 5], // +x
-        ];
-        let t = quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        TriMesh::new(v, t)
+        TriMesh::cuboid(min, max)
     }
 
     #[test]

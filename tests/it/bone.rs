@@ -142,32 +142,6 @@ fn simulate_reports_a_root_at_a_plate_in_its_table_and_json() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A closed box, its faces wound outwards.
-fn closed_box(lo: glam::Vec3, hi: glam::Vec3) -> orthosim::geometry::TriMesh {
-    let v: Vec<glam::Vec3> = (0..8)
-        .map(|k| {
-            glam::Vec3::new(
-                if k & 1 == 0 { lo.x } else { hi.x },
-                if k & 2 == 0 { lo.y } else { hi.y },
-                if k & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
-        .collect();
-    orthosim::geometry::TriMesh::new(v, triangles)
-}
-
 /// World positions of tooth `i`'s root samples.
 fn roots_of(sim: &Simulation, i: usize) -> Vec<glam::Vec3> {
     let t = &sim.teeth[i];
@@ -203,7 +177,7 @@ fn a_bone_mesh_named_by_the_case_holds_the_roots_it_covers_and_an_open_one_is_re
             .fold(f32::MIN, f32::max)
     };
     let front = labial(&envelope) + 0.3;
-    let mandible = closed_box(
+    let mandible = orthosim::geometry::TriMesh::cuboid(
         lo - glam::Vec3::splat(5.0),
         glam::Vec3::new(hi.x + 5.0, hi.y + 5.0, front),
     )
