@@ -1,20 +1,28 @@
 //! Bone meshes named by a case (a CBCT segmentation's maxilla and mandible) in place of the
 //! alveolar envelope ([`super::bone`]).
 //!
-//! A tooth is held by its arch's bone mesh when most of its root points lie inside the mesh as
-//! placed (otherwise the segmentation does not cover it and the envelope holds it). Root points
-//! already outside the bone as placed (a dehiscence or fenestration, or a segmentation that
-//! thinned the labial plate away) are not held: there is no bone there to resist them; they are
-//! counted per tooth ([`BoneMeshes::uncovered`]). Every held root point within the asked
-//! tolerance of the bone's surface, or outside it, is a contact with the surface at its nearest
-//! point: its depth the distance outside (negative inside), its inward direction towards the
-//! nearest point (away from it inside). Only the walls of the alveolus hold a root: where the
-//! surface faces up or down (within 45° of vertical: the crest, which follows an extruding
-//! tooth, and the basal bone and sinus floor) it does not. A contact's plate is buccal when the
-//! wall faces the cheeks or lips (the arch axis's outward normal), lingual otherwise.
+//! Segmentations give the bone either with the sockets filled (the roots inside the solid) or
+//! hollow (the teeth cut out: each root in a cavity, the socket's wall a fraction of a
+//! millimetre away). Every root point keeps the side of the bone's surface it started on: a
+//! tooth is held by its arch's mesh when at least half its root points lie inside the solid
+//! (filled sockets; those points are held) or, failing that, at least half lie outside it within
+//! [`SOCKET_MM`] of its surface (hollow sockets; those are held). Otherwise the segmentation does
+//! not cover the tooth and the envelope holds it. Root points not held (outside a filled bone: a
+//! dehiscence or fenestration, or a plate the segmentation thinned away) have no bone to resist
+//! them; they are counted per tooth ([`BoneMeshes::uncovered`]).
 //!
-//! Guarantee: exact for the mesh as given (nearest points exact; inside by the parity of ray
-//! crossings, retried when a ray grazes an edge).
+//! A held point within the asked tolerance of the surface on its own side, or across it, is a
+//! contact at the nearest surface point: its depth the distance across (negative on its own
+//! side), its inward direction back to its own side. Only the walls of the alveolus hold a root:
+//! where the surface there faces within 45° of up or down (the crest, which follows an extruding
+//! tooth; the basal bone, the sinus floor, a socket's fundus) it does not. A contact's plate is
+//! buccal when the root presses towards the cheeks or lips (the arch axis's outward normal),
+//! lingual otherwise.
+//!
+//! Guarantee: nearest points exact; the side by the parity of ray crossings within the
+//! tolerance (retried when a ray grazes an edge), and beyond it by the nearest triangle's
+//! outward normal, up to [`FAR_MM`] away (a point farther across the surface than that is not
+//! seen). A point nearer the crest than the wall is judged by the crest and not held.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -29,9 +37,13 @@ use crate::{
     teeth::{Arch, Fdi, arch::ArchCurve},
 };
 
-/// Fraction of a tooth's root points that must lie inside its arch's bone mesh for the mesh to
-/// hold the tooth.
+/// Fraction of a tooth's root points that must lie on the bone's side (filled sockets) or in its
+/// sockets (hollow ones) for the mesh to hold the tooth.
 pub const COVERED_FRACTION: f32 = 0.5;
+/// A root point outside the bone's solid this near its surface is in a hollow socket (mm).
+pub const SOCKET_MM: f32 = 1.0;
+/// How far across the surface a point is still seen (mm).
+pub const FAR_MM: f32 = 2.0;
 /// A wall whose normal is nearer vertical than this (its vertical component's size) does not
 /// hold a root: the crest and the basal bone.
 const MOST_VERTICAL: f32 = std::f32::consts::FRAC_1_SQRT_2;
@@ -58,8 +70,9 @@ impl ArchBone {
 #[derive(Clone, Debug)]
 pub struct BoneMeshes {
     arches: Vec<ArchBone>,
-    /// Per tooth held by a mesh: which of its root points (in the order given) are held.
-    held: BTreeMap<Fdi, Vec<bool>>,
+    /// Per tooth held by a mesh, each root point (in the order given): `None` not held,
+    /// `Some(true)` held inside the solid, `Some(false)` held outside it (in a hollow socket).
+    held: BTreeMap<Fdi, Vec<Option<bool>>>,
 }
 
 impl BoneMeshes {
@@ -86,14 +99,27 @@ impl BoneMeshes {
             let Some(bone) = arches.iter().find(|a| a.arch == t.fdi.arch()) else {
                 continue;
             };
-            let inside: Vec<bool> = t
-                .roots
+            let world: Vec<Vec3> = t.roots.iter().map(|p| t.pose.transform_point(*p)).collect();
+            let inside: Vec<bool> = world
                 .iter()
-                .map(|p| point_inside_mesh(bone.at(), t.pose.transform_point(*p)))
+                .map(|w| point_inside_mesh(bone.at(), *w))
                 .collect();
-            let count = inside.iter().filter(|v| **v).count();
-            if !inside.is_empty() && count as f32 >= COVERED_FRACTION * inside.len() as f32 {
-                held.insert(t.fdi, inside);
+            let enough =
+                |n: usize| !world.is_empty() && n as f32 >= COVERED_FRACTION * world.len() as f32;
+            if enough(inside.iter().filter(|v| **v).count()) {
+                held.insert(t.fdi, inside.iter().map(|v| v.then_some(true)).collect());
+                continue;
+            }
+            let socket: Vec<Option<bool>> = world
+                .iter()
+                .zip(&inside)
+                .map(|(w, i)| {
+                    let near = closest_point_and_triangle_within(bone.at(), *w, SOCKET_MM);
+                    (!i && near.is_some()).then_some(false)
+                })
+                .collect();
+            if enough(socket.iter().flatten().count()) {
+                held.insert(t.fdi, socket);
             }
         }
         (!held.is_empty()).then_some(Self { arches, held })
@@ -109,7 +135,7 @@ impl BoneMeshes {
     pub fn uncovered(&self) -> Vec<(Fdi, usize, usize)> {
         self.held
             .iter()
-            .map(|(f, h)| (*f, h.iter().filter(|v| !**v).count(), h.len()))
+            .map(|(f, h)| (*f, h.iter().filter(|v| v.is_none()).count(), h.len()))
             .collect()
     }
 
@@ -130,25 +156,40 @@ impl BoneMeshes {
             return Vec::new();
         };
         let mut out = Vec::new();
-        for (p, _) in roots.iter().zip(held).filter(|(_, h)| **h) {
+        for (p, side) in roots.iter().zip(held) {
+            let Some(own) = *side else {
+                continue;
+            };
             let w = pose.transform_point(*p);
-            let Some((q, d, tri)) = closest_point_and_triangle_within(bone.at(), w, tolerance)
+            let Some((q, d, tri)) =
+                closest_point_and_triangle_within(bone.at(), w, tolerance.max(FAR_MM))
             else {
                 continue;
             };
-            let inside = point_inside_mesh(bone.at(), w);
-            let inward = if d > 1e-5 {
-                if inside { (w - q) / d } else { (q - w) / d }
+            let [a, b, c] = bone.mesh.triangle(tri as usize);
+            let outward = (b - a).cross(c - a).normalize_or_zero();
+            let inside = if d <= tolerance {
+                point_inside_mesh(bone.at(), w)
             } else {
-                // On the surface: against the face's outward normal.
-                let [a, b, c] = bone.mesh.triangle(tri as usize);
-                -(b - a).cross(c - a).normalize_or_zero()
+                (w - q).dot(outward) < 0.0
+            };
+            let across = inside != own;
+            if !across && d > tolerance {
+                continue;
+            }
+            // Back to the point's own side: away from the surface on it, towards it across.
+            let inward = if d > 1e-5 {
+                if across { (q - w) / d } else { (w - q) / d }
+            } else if own {
+                -outward
+            } else {
+                outward
             };
             if inward.y.abs() > MOST_VERTICAL || inward == Vec3::ZERO {
                 continue;
             }
-            let (_, outward) = bone.axis.locate(Vec2::new(w.x, w.z));
-            let plate = if -inward.dot(Vec3::new(outward.x, 0.0, outward.y)) >= 0.0 {
+            let (_, arch_out) = bone.axis.locate(Vec2::new(w.x, w.z));
+            let plate = if -inward.dot(Vec3::new(arch_out.x, 0.0, arch_out.y)) >= 0.0 {
                 Plate::Buccal
             } else {
                 Plate::Lingual
@@ -156,7 +197,7 @@ impl BoneMeshes {
             out.push(PlateContact {
                 point: w,
                 inward,
-                depth: if inside { -d } else { d },
+                depth: if across { d } else { -d },
                 plate,
             });
         }
@@ -213,6 +254,69 @@ mod tests {
         let labial = past.iter().find(|c| c.plate == Plate::Buccal).unwrap();
         assert!((labial.depth - 0.3).abs() < 1e-4, "{labial:?}");
         assert!(labial.inward.distance(-Vec3::Z) < 1e-5);
+        // Hollow sockets: the same tooth in a cavity cut out of the bone, its walls 0.3 mm from
+        // the root labially and lingually; the root points keep to the cavity.
+        let outer = TriMesh::cuboid(
+            Vec3::new(-10.0, -20.0, zc - 10.0),
+            Vec3::new(10.0, 0.0, zc + 5.0),
+        );
+        let cavity = TriMesh::cuboid(
+            Vec3::new(-2.0, -15.0, zc - 1.0),
+            Vec3::new(2.0, -1.0, zc + 1.0),
+        );
+        let base = outer.vertices.len() as u32;
+        let hollow = Arc::new(TriMesh::new(
+            outer
+                .vertices
+                .iter()
+                .chain(&cavity.vertices)
+                .copied()
+                .collect(),
+            outer
+                .triangles
+                .iter()
+                .copied()
+                .chain(
+                    cavity
+                        .triangles
+                        .iter()
+                        .map(|[a, b, c]| [base + a, base + c, base + b]),
+                )
+                .collect(),
+        ));
+        let socket = [
+            Vec3::new(0.0, -8.0, zc + 0.7),
+            Vec3::new(0.0, -8.0, zc - 0.7),
+            Vec3::new(0.0, -12.0, zc + 0.2),
+        ];
+        let teeth = [RootedTooth {
+            fdi,
+            pose: Pose::IDENTITY,
+            roots: &socket,
+        }];
+        let bone = BoneMeshes::new(&[None, Some(hollow)], &teeth, [&curve, &curve]).unwrap();
+        assert_eq!(bone.uncovered(), vec![(fdi, 0, 3)]);
+        let at = |dz: f32| {
+            let pose = Pose::from_translation(Vec3::Z * dz);
+            let mut c = bone.contacts(fdi, &pose, &socket, 0.5);
+            c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
+            c
+        };
+        let c = at(0.0);
+        assert_eq!(c.len(), 2, "{c:?}");
+        assert_eq!((c[0].plate, c[1].plate), (Plate::Lingual, Plate::Buccal));
+        assert!((c[1].depth + 0.3).abs() < 1e-4 && c[1].inward.distance(-Vec3::Z) < 1e-5);
+        // Pushed 0.2 mm into the labial wall, and 1.5 mm into it (beyond the tolerance).
+        for (dz, depth) in [(0.5, 0.2), (1.8, 1.5)] {
+            let c = at(dz);
+            let labial = c
+                .iter()
+                .filter(|c| c.plate == Plate::Buccal)
+                .max_by(|a, b| a.depth.total_cmp(&b.depth))
+                .unwrap();
+            assert!((labial.depth - depth).abs() < 1e-4, "{dz}: {labial:?}");
+            assert!(labial.inward.distance(-Vec3::Z) < 1e-5, "{labial:?}");
+        }
         // A tooth mostly outside the mesh is left to the envelope.
         let out = [Vec3::new(0.0, -10.0, zc + 3.0); 3];
         let stray = [RootedTooth {

@@ -311,7 +311,8 @@ impl Simulation {
             rod,
             brackets,
             reactions: vec![Reaction::default(); n],
-            stiffness: vec![[[0.0; 6]; 6]; n],
+            // Found by the first solve (an empty list is never reused).
+            stiffness: Vec::new(),
             chains: Vec::new(),
             coils: Vec::new(),
             chain_forces: vec![DVec3::ZERO; n],
@@ -410,6 +411,8 @@ impl Simulation {
             b.node = node;
         }
         w.rod = Rod::new(laid.nodes, choice.size, choice.material);
+        // The new wire's stiffness at the brackets is its own, found by its first solve.
+        w.stiffness.clear();
         w.choice = choice;
         w.history.push((day, choice));
         self.solve_wire(k, ENGAGE_ITERATIONS);
@@ -501,7 +504,8 @@ impl Simulation {
                 let mut r = w.reactions[k];
                 r.force += w.chain_forces.get(k).copied().unwrap_or(DVec3::ZERO);
                 r.moment += w.chain_moments.get(k).copied().unwrap_or(DVec3::ZERO);
-                out.push((at, r, Mat6(w.stiffness[k])));
+                let stiffness = w.stiffness.get(k).copied().unwrap_or([[0.0; 6]; 6]);
+                out.push((at, r, Mat6(stiffness)));
             }
         }
         out

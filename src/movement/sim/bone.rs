@@ -83,7 +83,9 @@ impl Simulation {
             }))
             .collect();
         let curves = [&self.curves[0], &self.curves[1]];
-        self.bone_meshes = BoneMeshes::new(&self.bone_files, &rooted, curves);
+        // The meshes hold the teeth present (an extraction site is the envelope's to know).
+        let present = rooted.len() - extracted.len();
+        self.bone_meshes = BoneMeshes::new(&self.bone_files, &rooted[..present], curves);
         self.bone = Some(AlveolarEnvelope::new(&rooted, curves));
     }
 
