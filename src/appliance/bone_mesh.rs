@@ -210,6 +210,14 @@ mod tests {
     use super::*;
     use crate::teeth::arch::ArchLayout;
 
+    /// The contacts (within 0.5 mm) of tooth `fdi` moved `dz` mm labially, front to back.
+    fn shifted(bone: &BoneMeshes, fdi: Fdi, roots: &[Vec3], dz: f32) -> Vec<PlateContact> {
+        let pose = Pose::from_translation(Vec3::Z * dz);
+        let mut c = bone.contacts(fdi, &pose, roots, 0.5);
+        c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
+        c
+    }
+
     #[test]
     fn walls_hold_the_roots_they_cover_and_the_crest_and_missing_bone_do_not() {
         let curve = ArchCurve::new(&ArchLayout::default().lower);
@@ -234,12 +242,7 @@ mod tests {
         let bone = BoneMeshes::new(&[None, Some(mesh)], &teeth, [&curve, &curve]).unwrap();
         assert!(bone.holds(fdi) && !bone.holds(Fdi::new(11).unwrap()));
         assert_eq!(bone.uncovered(), vec![(fdi, 1, 5)]);
-        let at = |dz: f32| {
-            let pose = Pose::from_translation(Vec3::Z * dz);
-            let mut c = bone.contacts(fdi, &pose, &roots, 0.5);
-            c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
-            c
-        };
+        let at = |dz: f32| shifted(&bone, fdi, &roots, dz);
         // As placed: the labial and lingual walls, 0.2 mm inside each; not the crest, not the
         // point outside, not the deep one.
         let c = at(0.0);
@@ -296,12 +299,7 @@ mod tests {
         }];
         let bone = BoneMeshes::new(&[None, Some(hollow)], &teeth, [&curve, &curve]).unwrap();
         assert_eq!(bone.uncovered(), vec![(fdi, 0, 3)]);
-        let at = |dz: f32| {
-            let pose = Pose::from_translation(Vec3::Z * dz);
-            let mut c = bone.contacts(fdi, &pose, &socket, 0.5);
-            c.sort_by(|a, b| a.point.z.total_cmp(&b.point.z));
-            c
-        };
+        let at = |dz: f32| shifted(&bone, fdi, &socket, dz);
         let c = at(0.0);
         assert_eq!(c.len(), 2, "{c:?}");
         assert_eq!((c[0].plate, c[1].plate), (Plate::Lingual, Plate::Buccal));

@@ -27,9 +27,10 @@
 //! geometric stiffness (the stress resultants on the strains' curvature, by differences of the
 //! exact derivatives) is added for Newton's quadratic convergence. A line search on the energy
 //! keeps every step monotone, and the tangent's factor is reused while it quarters the residual.
-//! A step the line search cuts short stiffens the next tangent's diagonal (Levenberg–Marquardt:
-//! a wire free within its slots' play is nearly a mechanism, and an undamped tangent sends it
-//! millimetres along the arch); full steps relax the damping back to pure Newton.
+//! A step the line search cuts below half stiffens the next tangent's diagonal
+//! (Levenberg–Marquardt: a wire free within its slots' play is nearly a mechanism, and an
+//! undamped tangent sends it millimetres along the arch); longer steps relax the damping back to
+//! pure Newton.
 
 use glam::{DQuat, DVec3};
 
@@ -553,9 +554,10 @@ impl Rod {
                 self.factor = None;
             }
             geometric_too = hi >= 1.0;
-            // Levenberg–Marquardt: a step the line search had to cut short means the tangent
+            // Levenberg–Marquardt: a step the line search cut below half means the tangent
             // promised too much (a wire free within its slots' play is soft in whole-wire
-            // slides and turns); the next tangent stiffens its diagonal, a full step relaxes it.
+            // slides and turns); the next tangent stiffens its diagonal, and a step kept at
+            // least half relaxes it.
             damping = if hi < 0.5 {
                 (damping * 10.0).clamp(1e-4, 1.0)
             } else if damping < 1e-8 {

@@ -3,15 +3,12 @@
 
 use std::path::Path;
 
-use super::{ImportError, Repairs, Units, check_raw, read_in_mm};
+use super::{ImportError, RepairLimits, Repairs, Units, check_raw, read_in_mm};
 use crate::geometry::TriMesh;
 
-/// Welding distance for a bone mesh's vertices (mm): files that repeat each corner per triangle,
-/// as STL does, show their surface whole once welded.
-const WELD_MM: f32 = 1e-4;
-
-/// Reads the bone mesh at `path` in millimetres (the file's frame): welded, every edge shared by
-/// two triangles, wound with its normals outwards.
+/// Reads the bone mesh at `path` in millimetres (the file's frame): welded as the teeth's meshes
+/// are (files that repeat each corner per triangle, as STL does, show their surface whole once
+/// welded), every edge shared by two triangles, wound with its normals outwards.
 ///
 /// # Errors
 /// What is wrong and where, without the path: unreadable, empty, non-finite, bad indices, or open
@@ -19,7 +16,11 @@ const WELD_MM: f32 = 1e-4;
 pub fn read_bone(path: &Path, units: Units) -> Result<TriMesh, ImportError> {
     let raw = read_in_mm(path, units)?;
     check_raw(&raw)?;
-    let (vertices, triangles) = super::repair::weld(&raw, WELD_MM, &mut Repairs::default());
+    let (vertices, triangles) = super::repair::weld(
+        &raw,
+        RepairLimits::default().weld_mm,
+        &mut Repairs::default(),
+    );
     let mut mesh = TriMesh::new(vertices, triangles);
     let open = mesh.open_edges();
     if let Some(&(a, _)) = open.first() {
