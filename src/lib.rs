@@ -94,6 +94,7 @@ pub mod movement;
 #[cfg(feature = "viewer")]
 pub mod occlusion_view;
 pub mod parallel;
+pub mod planning;
 #[cfg(feature = "ecs")]
 pub mod simulation;
 pub mod sphere_tree;

@@ -38,6 +38,10 @@ enum Command {
     /// Where the arches meet: contacts, areas, the incisor gap; `--settle` closes the lower arch
     /// onto the upper under a bite force until it is stable.
     Occlusion(cli::occlusion::OcclusionArgs),
+    /// A staged treatment plan from the teeth as they stand to a target: stages within per-stage
+    /// limits, no tooth passing through another, IPR where they must pass; plan.json, stage STLs
+    /// and an HTML page.
+    Plan(cli::plan::PlanArgs),
     /// Compare the periodontal-ligament model with published biomechanics (centres of
     /// resistance and rotation, moment-to-force ratios, displacement, rate of movement).
     Validate(cli::validate::ValidateArgs),
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => cli::bench::run(args),
         Command::Validate(args) => cli::validate::run(args),
         Command::Occlusion(args) => cli::occlusion::run(args),
+        Command::Plan(args) => cli::plan::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,6 +16,7 @@ pub mod measures;
 pub mod occlusal_map;
 pub mod occlusion;
 pub mod pareto_plot;
+pub mod plan_report;
 pub mod plot;
 pub mod report;
 

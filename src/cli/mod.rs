@@ -10,6 +10,7 @@ pub mod choice;
 pub mod export_case;
 pub mod inspect;
 pub mod occlusion;
+pub mod plan;
 pub mod report;
 pub mod screenshot;
 pub mod simulate;

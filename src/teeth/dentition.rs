@@ -10,7 +10,7 @@ use super::{
         ArchCurve, ArchLayout, Arrangement, BetaArch, OcclusionMeasures, Spaces,
         irregularity::{Anterior, ContactPoints},
     },
-    case::{Case, CaseError, CaseVector, LoadedCase, WireModel},
+    case::{Case, CaseError, CaseOffset, CaseVector, LoadedCase, WireModel},
     fdi::{Arch, Fdi},
     import::Repairs,
     patient::{OrientationReport, patient_teeth},
@@ -65,6 +65,23 @@ impl PlacedTooth {
                 m * mesial.0 + b * buccal.0 + o * occlusal.0
             }
         }
+    }
+
+    /// The pose after moving the tooth by `offset`: turned about its crown centre (mesial axis,
+    /// then buccal, then occlusal), then shifted along its anatomical axes, all taken at the
+    /// present pose.
+    pub fn offset_pose(&self, offset: &CaseOffset) -> Pose {
+        let [m, b, o] = self.anatomical_axes();
+        let (t, r) = (offset.translation, offset.rotation_deg);
+        let rotation = Quat::from_axis_angle(m, r.0.0.to_radians())
+            * Quat::from_axis_angle(b, r.1.0.to_radians())
+            * Quat::from_axis_angle(o, r.2.0.to_radians());
+        let pivot = self.crown_centre();
+        let about_pivot = Pose::from_translation(pivot)
+            .mul(&Pose::new(rotation, Vec3::ZERO))
+            .mul(&Pose::from_translation(-pivot));
+        let shift = Pose::from_translation(m * t.0.0 + b * t.1.0 + o * t.2.0);
+        shift.mul(&about_pivot).mul(&self.pose)
     }
 
     /// The crown centre in the world frame.
@@ -206,17 +223,7 @@ impl Dentition {
             .collect();
         for tooth in &mut teeth {
             if let Some(offset) = case.offsets.0.get(&tooth.fdi) {
-                let [m, b, o] = tooth.anatomical_axes();
-                let (t, r) = (offset.translation, offset.rotation_deg);
-                let rotation = Quat::from_axis_angle(m, r.0.0.to_radians())
-                    * Quat::from_axis_angle(b, r.1.0.to_radians())
-                    * Quat::from_axis_angle(o, r.2.0.to_radians());
-                let pivot = tooth.crown_centre();
-                let about_pivot = Pose::from_translation(pivot)
-                    .mul(&Pose::new(rotation, Vec3::ZERO))
-                    .mul(&Pose::from_translation(-pivot));
-                let shift = Pose::from_translation(m * t.0.0 + b * t.1.0 + o * t.2.0);
-                tooth.pose = shift.mul(&about_pivot).mul(&tooth.pose);
+                tooth.pose = tooth.offset_pose(offset);
             }
         }
         if !case.offsets.0.is_empty() {

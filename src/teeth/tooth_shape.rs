@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 use super::{
     anatomy::{ToothAnatomy, anatomy},
@@ -33,6 +33,12 @@ pub struct ToothGeometry {
     pub frame: ToothFrame,
     /// Cusp tips and incisal points in the local frame (for occlusion measures).
     pub cusp_tips: Vec<Vec3>,
+    /// The crown's anatomical axes in the local frame: the rotation from the local frame to the
+    /// frame whose x, y and z are the crown's mesio-distal, occlusal and buccal axes (the
+    /// procedural tooth's local frame). Identity where the local frame is anatomical (procedural
+    /// teeth); for a scanned crown, its fitted template's orientation (identity without one), as
+    /// its local frame takes its buccal axis from the arch and cannot show the crown's rotation.
+    pub axes: Quat,
 }
 
 impl ToothGeometry {
@@ -73,6 +79,7 @@ impl ToothGeometry {
             kind,
             anatomy: anatomy(arch, kind),
             cusp_tips,
+            axes: Quat::IDENTITY,
             mesh,
             bvh,
             stars,

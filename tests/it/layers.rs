@@ -8,7 +8,7 @@ use std::{
 };
 
 /// Layers, lowest first: a module may use only the ones before it (and itself).
-const ORDER: [&str; 13] = [
+const ORDER: [&str; 14] = [
     "geometry",
     "io",
     "parallel",
@@ -18,6 +18,7 @@ const ORDER: [&str; 13] = [
     "appliance",
     "simulation",
     "movement",
+    "planning",
     "analysis",
     "occlusion_view",
     "ui",

@@ -131,6 +131,10 @@ pub struct Case {
     /// Per-tooth displacements from the arch.
     #[serde(default)]
     pub offsets: ToothMap<CaseOffset>,
+    /// A treatment target for `orthosim plan`: each listed tooth's movement from where it stands,
+    /// in the same form as `offsets`; unlisted teeth stay. Empty: the plan sets the target up.
+    #[serde(default, skip_serializing_if = "ToothMap::is_empty")]
+    pub target: ToothMap<CaseOffset>,
     /// Loads.
     #[serde(default)]
     pub loads: Vec<CaseLoad>,
@@ -403,26 +407,27 @@ impl Case {
                 ));
             }
         }
-        for (f, offset) in &self.offsets.0 {
-            absent("offsets", f)?;
-            let (t, r) = (offset.translation, offset.rotation_deg);
-            if [t.0, t.1, t.2].iter().any(|c| c.0.abs() > MAX_OFFSET_MM) {
-                return Err((
-                    "offsets",
-                    Some(f.to_string()),
-                    format!(
-                        "offset of tooth {f} is beyond the {MAX_OFFSET_MM} mm accepted per axis"
-                    ),
-                ));
-            }
-            if [r.0, r.1, r.2].iter().any(|c| c.0.abs() > MAX_OFFSET_DEG) {
-                return Err((
-                    "offsets",
-                    Some(f.to_string()),
-                    format!(
-                        "rotation of tooth {f} is beyond the {MAX_OFFSET_DEG}° accepted per axis"
-                    ),
-                ));
+        for (field, map) in [("offsets", &self.offsets), ("target", &self.target)] {
+            let what = if field == "offsets" {
+                "offset"
+            } else {
+                "target movement"
+            };
+            for (f, offset) in &map.0 {
+                absent(field, f)?;
+                let (t, r) = (offset.translation, offset.rotation_deg);
+                if [t.0, t.1, t.2].iter().any(|c| c.0.abs() > MAX_OFFSET_MM) {
+                    let m = format!(
+                        "{what} of tooth {f} is beyond the {MAX_OFFSET_MM} mm accepted per axis"
+                    );
+                    return Err((field, Some(f.to_string()), m));
+                }
+                if [r.0, r.1, r.2].iter().any(|c| c.0.abs() > MAX_OFFSET_DEG) {
+                    let m = format!(
+                        "{what} rotation of tooth {f} is beyond the {MAX_OFFSET_DEG}° accepted per axis"
+                    );
+                    return Err((field, Some(f.to_string()), m));
+                }
             }
         }
         for f in self.meshes.0.keys() {

@@ -75,6 +75,13 @@ impl<'de> Deserialize<'de> for ToothList {
 #[serde(transparent)]
 pub struct ToothMap<T>(pub BTreeMap<Fdi, T>);
 
+impl<T> ToothMap<T> {
+    /// True when no tooth is listed.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
 impl<T> Default for ToothMap<T> {
     fn default() -> Self {
         Self(BTreeMap::new())

@@ -49,6 +49,9 @@ pub(super) struct Closed {
     pub cervical: Option<Vec3>,
     /// The root's apical direction (unit), when a root was generated.
     pub apical: Option<Vec3>,
+    /// The crown's anatomical orientation (world), when a template was fitted to it: the
+    /// fitted template's rotation before its root was turned away from the neighbours'.
+    pub crown_rotation: Option<glam::Quat>,
 }
 
 /// Which root a scanned crown gets.
@@ -217,10 +220,17 @@ pub(super) fn close(
                 repairs.holes_closed_mm.extend(holes);
                 repairs.root_generated_margin_mm = margin.map(|m| lengths[m]);
                 repairs.root = root;
+                let crown_rotation = match (choice, guide) {
+                    (RootChoice::Template(g), Some((_, f))) => Some(
+                        (glam::Quat::from_scaled_axis(g.tilt).inverse() * f.rotation).normalize(),
+                    ),
+                    _ => None,
+                };
                 return Ok(Closed {
                     mesh: mesh.without_unused_vertices(),
                     cervical,
                     apical,
+                    crown_rotation,
                 });
             }
             if fewest.as_ref().is_none_or(|(_, p)| pairs.len() < p.len()) {

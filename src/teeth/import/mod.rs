@@ -307,6 +307,8 @@ pub struct Prepared {
     pub cervical: Option<Vec3>,
     /// The generated root's apical direction (unit), for a scanned crown.
     pub apical: Option<Vec3>,
+    /// The crown's anatomical orientation (world) from its fitted template, when it has one.
+    pub crown_rotation: Option<Quat>,
     /// What was repaired.
     pub repairs: Repairs,
 }
@@ -375,6 +377,7 @@ pub fn prepare_guided(
         mesh,
         cervical,
         apical,
+        crown_rotation,
     } = match close::close(
         crown.clone(),
         fdi,
@@ -404,6 +407,7 @@ pub fn prepare_guided(
         mesh,
         cervical,
         apical,
+        crown_rotation,
         repairs,
     })
 }
@@ -458,7 +462,10 @@ impl Prepared {
         let pose = self.pose(fdi, curve);
         let inverse = pose.inverse();
         let local = self.mesh.map_vertices(|v| inverse.transform_point(v));
-        let geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
+        let mut geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
+        if let Some(r) = self.crown_rotation {
+            geometry.axes = (pose.rotation.inverse() * r).normalize();
+        }
         ImportedTooth {
             geometry,
             pose,

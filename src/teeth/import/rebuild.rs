@@ -128,6 +128,7 @@ pub fn rebuild_guided(
         mesh,
         cervical,
         apical,
+        crown_rotation: None,
         repairs,
     })
 }

@@ -1,0 +1,559 @@
+//! Staging: from the initial teeth to the target in stages within the limits, with no two teeth
+//! of an arch passing through each other at any stage or between stages.
+//!
+//! 1. Each tooth's movement is split into the fewest stages its limits allow ([`ToothMove`]);
+//!    the sequence sets when each starts (and a case's `wait` delays a tooth further).
+//! 2. Every transition from one stage to the next is checked for every pair of teeth of an arch
+//!    that can come near during it ([`clearance::transition`]: conservative advancement on the
+//!    exact mesh distance). A pair may overlap by what it already overlapped in the scan
+//!    (never deeper) and, from the stage its IPR is done, by the enamel removed; beyond that, plus
+//!    `tolerance_mm`, it collides.
+//! 3. The earliest collision is resolved, and the plan checked again (the measures of transitions
+//!    that did not change are kept): a pair whose target needs IPR gets it at the stage before
+//!    the collision; otherwise the tooth that moves into the other waits a stage; a pair still
+//!    colliding at its target, or whose tooth has waited the whole plan, gets IPR at the
+//!    colliding contact in `ipr_step_mm` steps within its limit; failing that the pair is
+//!    reported as blocked, with the stage and depth, and the plan goes on without it.
+//!
+//! The opposing arch is not checked: stages move the teeth of one arch among themselves (the
+//! bite open, as it is while aligners are worn).
+
+use std::collections::{BTreeMap, HashMap};
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use serde::Serialize;
+
+use super::clearance::{self, BAND_MM, Clearance, Mover};
+use super::limits::{PlanLimits, group};
+use super::moves::ToothMove;
+use super::target::{ArchSetup, Target};
+use crate::collision::Motion;
+use crate::geometry::mesh_separation;
+use crate::teeth::{Arch, Dentition, Fdi, PlacedTooth, arch::ArchCurve};
+
+/// Most resolution rounds before the remaining collisions are reported as blocked.
+const MAX_ROUNDS: usize = 2000;
+
+/// A tooth of the plan.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlanTooth {
+    /// The tooth.
+    pub fdi: Fdi,
+    /// Crown-centre travel from the initial to the target place (mm).
+    pub total_mm: f32,
+    /// Rotation from the initial to the target orientation (degrees).
+    pub total_deg: f32,
+    /// The movement's components in the arch's frame at the tooth (mesio-distal, bucco-lingual,
+    /// vertical mm; rotation, tip, torque degrees).
+    pub components: [f32; 6],
+    /// The stage it starts moving after (0: from the first stage).
+    pub start: u32,
+    /// Stages it moves in.
+    pub moving_stages: u32,
+    /// Where it stands at each stage, 0 (initial) to the last: the crown centre's displacement
+    /// from the initial place (x, y, z mm, world) and the rotation from the initial orientation
+    /// as a rotation vector (x, y, z degrees, world).
+    pub stages: Vec<[f32; 6]>,
+}
+
+/// IPR at one contact.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PlanIpr {
+    /// One tooth of the contact (nearer the patient's right).
+    pub a: Fdi,
+    /// The other.
+    pub b: Fdi,
+    /// The stage at which it is done (before the teeth move on from it).
+    pub stage: u32,
+    /// Enamel removed (mm, both teeth together, half from each).
+    pub mm: f32,
+}
+
+/// A pair the plan could not take past each other.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Blocked {
+    /// One tooth.
+    pub a: Fdi,
+    /// The other.
+    pub b: Fdi,
+    /// The transition from this stage to the next where they collide.
+    pub stage: u32,
+    /// How deep they go inside each other beyond what is allowed (mm).
+    pub depth_mm: f32,
+    /// Why the stager could not resolve it.
+    pub why: String,
+}
+
+/// A staged plan.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    /// The case's name.
+    pub case: String,
+    /// Number of stages after the initial one.
+    pub stages: u32,
+    /// The limits it was planned within.
+    pub limits: PlanLimits,
+    /// `automatic` or `file`.
+    pub target: &'static str,
+    /// How the automatic target set up each arch.
+    pub setup: Vec<ArchSetup>,
+    /// IPR, by stage.
+    pub ipr: Vec<PlanIpr>,
+    /// Every present tooth.
+    pub teeth: Vec<PlanTooth>,
+    /// Deepest penetration measured anywhere in the plan beyond what is allowed (mm; 0: none).
+    pub max_penetration_mm: f32,
+    /// Deepest overlap of two teeth in the scan as it stands (mm; 0: none).
+    pub scan_overlap_mm: f32,
+    /// Pairs the plan could not take past each other.
+    pub blocked: Vec<Blocked>,
+    /// Exact distance queries made.
+    pub measures: u64,
+    /// Resolution rounds.
+    pub rounds: usize,
+    /// Time to set up the target (ms).
+    pub target_ms: f64,
+    /// Time to stage and check (ms).
+    pub plan_ms: f64,
+    /// The movements, for stage meshes and the viewer.
+    #[serde(skip)]
+    pub moves: Vec<ToothMove>,
+}
+
+impl Plan {
+    /// Every present tooth's pose at stage `k`.
+    pub fn poses_at(&self, k: u32) -> Vec<(Fdi, crate::geometry::Pose)> {
+        self.moves.iter().map(|m| (m.fdi, m.pose_at(k))).collect()
+    }
+}
+
+/// A tooth's bounding sphere in its local frame.
+fn bounding_sphere(t: &PlacedTooth) -> (Vec3, f32) {
+    let v = &t.geometry.mesh.vertices;
+    let (lo, hi) = v.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let c = 0.5 * (lo + hi);
+    let r = v.iter().map(|p| p.distance(c)).fold(0.0f32, f32::max);
+    (c, r)
+}
+
+/// The arch's mesial and buccal unit directions at a tooth's place.
+fn arch_axes(d: &Dentition, t: &PlacedTooth) -> [Vec3; 2] {
+    let form = d.arch_forms[if t.fdi.arch() == Arch::Upper { 0 } else { 1 }];
+    let curve = ArchCurve::new(&form);
+    let s = curve.project(Vec2::new(t.pose.translation.x, t.pose.translation.z));
+    let (_, tangent) = curve.at(s);
+    let along = Vec3::new(tangent.x, 0.0, tangent.y);
+    let out = Vec3::new(-tangent.y, 0.0, tangent.x);
+    let mesial = if s > 0.0 { -along } else { along };
+    [mesial, out]
+}
+
+/// Cache key of one pair over one transition: the teeth and their fractions done at both ends.
+type Key = (usize, usize, [u32; 4]);
+
+struct Stager<'a> {
+    teeth: Vec<&'a PlacedTooth>,
+    moves: Vec<ToothMove>,
+    spheres: Vec<(Vec3, f32)>,
+    pairs: Vec<(usize, usize)>,
+    limits: &'a PlanLimits,
+    /// Overlap each pair had in the scan (mm, ≥ 0).
+    scan_overlap: HashMap<(usize, usize), f32>,
+    /// IPR the target needs per pair (mm).
+    target_ipr: HashMap<(usize, usize), f32>,
+    /// IPR scheduled per pair: (stage, mm).
+    ipr: BTreeMap<(usize, usize), (u32, f32)>,
+    cache: HashMap<Key, Clearance>,
+    speeds: HashMap<(usize, [u32; 2]), f64>,
+    measures: u64,
+    /// Stages each tooth has been made to wait.
+    waited: Vec<u32>,
+    /// Most stages a tooth is made to wait: as many as the plan had before any wait.
+    wait_cap: u32,
+    /// Pairs given up on.
+    blocked: Vec<Blocked>,
+}
+
+/// Plans the movement from the dentition as it stands to `target` (see the module doc).
+pub fn plan(d: &Dentition, target: &Target, limits: &PlanLimits, target_ms: f64) -> Plan {
+    let started = Instant::now();
+    let teeth: Vec<&PlacedTooth> = d.visible().collect();
+    let per_stage = limits.per_stage();
+    let mut moves: Vec<ToothMove> = teeth
+        .iter()
+        .map(|t| {
+            let end = target.poses.get(&t.fdi).copied().unwrap_or(t.pose);
+            let pivot = t.geometry.frame.crown_centre;
+            ToothMove::new(t.fdi, t.pose, end, pivot, arch_axes(d, t), &per_stage)
+        })
+        .collect();
+    let mut group_stages = [0u32; 4];
+    for m in &moves {
+        let g = group(m.fdi.kind());
+        group_stages[g] = group_stages[g].max(m.steps);
+    }
+    for m in &mut moves {
+        m.start_stage = limits.start_stage(m.fdi, group_stages);
+    }
+    let mut pairs = Vec::new();
+    for i in 0..teeth.len() {
+        for j in i + 1..teeth.len() {
+            if teeth[i].fdi.arch() == teeth[j].fdi.arch() {
+                pairs.push((i, j));
+            }
+        }
+    }
+    let index = |f: Fdi| teeth.iter().position(|t| t.fdi == f);
+    let target_ipr = target
+        .ipr
+        .iter()
+        .filter_map(|c| Some((ordered(index(c.a)?, index(c.b)?), c.mm)))
+        .collect();
+    let spheres = teeth.iter().map(|t| bounding_sphere(t)).collect();
+    let mut s = Stager {
+        waited: vec![0; teeth.len()],
+        wait_cap: 0,
+        teeth,
+        moves,
+        spheres,
+        pairs,
+        limits,
+        scan_overlap: HashMap::new(),
+        target_ipr,
+        ipr: BTreeMap::new(),
+        cache: HashMap::new(),
+        speeds: HashMap::new(),
+        measures: 0,
+        blocked: Vec::new(),
+    };
+    s.measure_scan();
+    s.wait_cap = s.stages().max(1);
+    let mut rounds = 0;
+    while rounds < MAX_ROUNDS {
+        let Some((k, i, j, excess)) = s.first_collision() else {
+            break;
+        };
+        rounds += 1;
+        s.resolve(k, i, j, excess);
+    }
+    if rounds >= MAX_ROUNDS {
+        while let Some((k, i, j, excess)) = s.first_collision() {
+            s.block(
+                k,
+                i,
+                j,
+                excess,
+                format!("still colliding after {MAX_ROUNDS} rounds"),
+            );
+        }
+    }
+    s.finish(d, target, limits, rounds, target_ms, started)
+}
+
+fn ordered(i: usize, j: usize) -> (usize, usize) {
+    (i.min(j), i.max(j))
+}
+
+impl<'a> Stager<'a> {
+    fn stages(&self) -> u32 {
+        self.moves.iter().map(|m| m.end_stage()).max().unwrap_or(0)
+    }
+
+    /// The overlap of every pair as the scan stands.
+    fn measure_scan(&mut self) {
+        for &(i, j) in &self.pairs {
+            let (a, b) = (self.teeth[i], self.teeth[j]);
+            let (ca, ra) = self.spheres[i];
+            let (cb, rb) = self.spheres[j];
+            if a.pose
+                .transform_point(ca)
+                .distance(b.pose.transform_point(cb))
+                > ra + rb
+            {
+                continue;
+            }
+            self.measures += 1;
+            let gap = mesh_separation(
+                a.geometry.mesh_ref(),
+                &a.pose,
+                b.geometry.mesh_ref(),
+                &b.pose,
+            )
+            .signed_gap();
+            if gap < 0.0 {
+                self.scan_overlap.insert((i, j), -gap);
+            }
+        }
+    }
+
+    /// Penetration allowed to pair (i, j) during the transition from stage `k`.
+    fn allowed(&self, i: usize, j: usize, k: u32) -> f32 {
+        let scan = self.scan_overlap.get(&(i, j)).copied().unwrap_or(0.0);
+        let ipr = match self.ipr.get(&(i, j)) {
+            Some(&(stage, mm)) if stage <= k => mm,
+            _ => 0.0,
+        };
+        scan + ipr + self.limits.tolerance_mm.0
+    }
+
+    fn speed(&mut self, i: usize, fr: [f32; 2]) -> f64 {
+        let key = (i, fr.map(f32::to_bits));
+        if let Some(s) = self.speeds.get(&key) {
+            return *s;
+        }
+        let m = &self.moves[i];
+        let motion = Motion {
+            start: m.at_fraction(fr[0]),
+            end: m.at_fraction(fr[1]),
+        };
+        let speed = Mover::new(self.teeth[i].geometry.mesh_ref(), motion).speed;
+        self.speeds.insert(key, speed);
+        speed
+    }
+
+    /// The check of pair (i, j) over the transition from stage k (cached).
+    fn check(&mut self, i: usize, j: usize, k: u32) -> Option<Clearance> {
+        let (mi, mj) = (&self.moves[i], &self.moves[j]);
+        let fi = [mi.fraction_at(k), mi.fraction_at(k + 1)];
+        let fj = [mj.fraction_at(k), mj.fraction_at(k + 1)];
+        if fi[0] == fi[1] && fj[0] == fj[1] {
+            // Neither moves: as at the end of the last transition that moved them.
+            return None;
+        }
+        let key = (i, j, [fi[0], fi[1], fj[0], fj[1]].map(f32::to_bits));
+        if let Some(c) = self.cache.get(&key) {
+            return Some(*c);
+        }
+        let (si, sj) = (self.speed(i, fi), self.speed(j, fj));
+        let (mi, mj) = (&self.moves[i], &self.moves[j]);
+        let (pi0, pj0) = (mi.at_fraction(fi[0]), mj.at_fraction(fj[0]));
+        let ((ci, ri), (cj, rj)) = (self.spheres[i], self.spheres[j]);
+        let apart = pi0.transform_point(ci).distance(pj0.transform_point(cj)) - ri - rj;
+        let c = if apart as f64 > si + sj + 2.0 * BAND_MM as f64 {
+            Clearance {
+                least_gap_mm: f32::INFINITY,
+                at: 0.0,
+                measures: 0,
+                complete: true,
+            }
+        } else {
+            let a = Mover {
+                mesh: self.teeth[i].geometry.mesh_ref(),
+                motion: Motion {
+                    start: pi0,
+                    end: mi.at_fraction(fi[1]),
+                },
+                speed: si,
+            };
+            let b = Mover {
+                mesh: self.teeth[j].geometry.mesh_ref(),
+                motion: Motion {
+                    start: pj0,
+                    end: mj.at_fraction(fj[1]),
+                },
+                speed: sj,
+            };
+            clearance::transition(&a, &b)
+        };
+        self.measures += c.measures as u64;
+        self.cache.insert(key, c);
+        Some(c)
+    }
+
+    /// The earliest transition with a colliding pair: (stage, i, j, depth beyond allowed).
+    fn first_collision(&mut self) -> Option<(u32, usize, usize, f32)> {
+        let n = self.stages();
+        for k in 0..n {
+            for p in 0..self.pairs.len() {
+                let (i, j) = self.pairs[p];
+                if self.is_blocked(i, j) {
+                    continue;
+                }
+                let Some(c) = self.check(i, j, k) else {
+                    continue;
+                };
+                let excess = c.excess(self.allowed(i, j, k));
+                if excess > 0.0 || !c.complete {
+                    return Some((k, i, j, excess));
+                }
+            }
+        }
+        None
+    }
+
+    fn is_blocked(&self, i: usize, j: usize) -> bool {
+        let (a, b) = (self.teeth[i].fdi, self.teeth[j].fdi);
+        self.blocked.iter().any(|x| x.a == a && x.b == b)
+    }
+
+    fn block(&mut self, k: u32, i: usize, j: usize, excess: f32, why: String) {
+        self.blocked.push(Blocked {
+            a: self.teeth[i].fdi,
+            b: self.teeth[j].fdi,
+            stage: k,
+            depth_mm: excess,
+            why,
+        });
+    }
+
+    /// True when i and j are neighbours along their arch (nothing present between them).
+    fn neighbours(&self, i: usize, j: usize) -> bool {
+        let (a, b) = (
+            self.teeth[i].fdi.arch_index(),
+            self.teeth[j].fdi.arch_index(),
+        );
+        let (lo, hi) = (a.min(b), a.max(b));
+        !self.teeth.iter().any(|t| {
+            t.fdi.arch() == self.teeth[i].fdi.arch()
+                && t.fdi.arch_index() > lo
+                && t.fdi.arch_index() < hi
+        })
+    }
+
+    /// The first transition at which pair (i, j) collides, if any.
+    fn pair_collision(&mut self, i: usize, j: usize) -> Option<u32> {
+        (0..self.stages()).find(|&k| {
+            self.check(i, j, k)
+                .is_some_and(|c| c.excess(self.allowed(i, j, k)) > 0.0 || !c.complete)
+        })
+    }
+
+    /// Resolves the collision of pair (i, j) at the transition from stage `k` (see the module
+    /// doc).
+    fn resolve(&mut self, k: u32, i: usize, j: usize, excess: f32) {
+        // The target's own IPR, done before the teeth first collide.
+        if let Some(&mm) = self.target_ipr.get(&(i, j)) {
+            let done = self.ipr.get(&(i, j)).copied();
+            if !done.is_some_and(|(stage, have)| stage <= k && have >= mm) {
+                let have = done.map_or(0.0, |x| x.1);
+                self.ipr.insert((i, j), (k, mm.max(have)));
+                return;
+            }
+        }
+        // A tooth that moves in this transition waits a stage, if that takes the pair's first
+        // collision later; of the two, the one that takes it furthest.
+        let mut best: Option<(usize, u32)> = None;
+        for who in [i, j] {
+            let m = &self.moves[who];
+            if m.fraction_at(k) == m.fraction_at(k + 1) || self.waited[who] >= self.wait_cap {
+                continue;
+            }
+            self.moves[who].start_stage += 1;
+            let next = self.pair_collision(i, j).unwrap_or(u32::MAX);
+            self.moves[who].start_stage -= 1;
+            if next > k && best.is_none_or(|(_, b)| next > b) {
+                best = Some((who, next));
+            }
+        }
+        if let Some((who, _)) = best {
+            self.moves[who].start_stage += 1;
+            self.waited[who] += 1;
+            return;
+        }
+        // IPR at the contact, in steps, within its limit.
+        let step = self.limits.ipr_step_mm.0;
+        let limit = self
+            .limits
+            .ipr
+            .between(self.teeth[i].fdi, self.teeth[j].fdi);
+        let have = self.ipr.get(&(i, j)).map_or(0.0, |x| x.1);
+        let want = have + (excess / step).ceil().max(1.0) * step;
+        if self.neighbours(i, j) && want <= limit + 1e-4 {
+            let stage = self.ipr.get(&(i, j)).map_or(k, |x| x.0.min(k));
+            self.ipr.insert((i, j), (stage, want));
+            return;
+        }
+        let why = if !self.neighbours(i, j) {
+            "no wait parts them, and they are not neighbours, so IPR cannot".to_owned()
+        } else {
+            format!(
+                "no wait parts them, and IPR of {want:.2} mm would pass the contact's {limit:.2} mm limit"
+            )
+        };
+        self.block(k, i, j, excess, why);
+    }
+
+    fn finish(
+        self,
+        d: &Dentition,
+        target: &Target,
+        limits: &PlanLimits,
+        rounds: usize,
+        target_ms: f64,
+        started: Instant,
+    ) -> Plan {
+        let n = self.stages();
+        let mut max_excess = 0.0f32;
+        let mut stager = self;
+        for k in 0..n {
+            for p in 0..stager.pairs.len() {
+                let (i, j) = stager.pairs[p];
+                if let Some(c) = stager.check(i, j, k) {
+                    max_excess =
+                        max_excess.max(c.excess(stager.allowed(i, j, k) - limits.tolerance_mm.0));
+                }
+            }
+        }
+        let teeth = stager
+            .moves
+            .iter()
+            .map(|m| {
+                let c0 = m.start.transform_point(m.pivot);
+                let stages = (0..=n)
+                    .map(|k| {
+                        let p = m.pose_at(k);
+                        let d = p.transform_point(m.pivot) - c0;
+                        let mut q = p.rotation * m.start.rotation.inverse();
+                        if q.w < 0.0 {
+                            q = -q;
+                        }
+                        let r = q.to_scaled_axis() * 180.0 / std::f32::consts::PI;
+                        [d.x, d.y, d.z, r.x, r.y, r.z]
+                    })
+                    .collect();
+                let (total_mm, total_deg) = m.totals();
+                PlanTooth {
+                    fdi: m.fdi,
+                    total_mm,
+                    total_deg,
+                    components: m.components,
+                    start: m.start_stage,
+                    moving_stages: m.steps,
+                    stages,
+                }
+            })
+            .collect();
+        let ipr = stager
+            .ipr
+            .iter()
+            .map(|(&(i, j), &(stage, mm))| PlanIpr {
+                a: stager.teeth[i].fdi,
+                b: stager.teeth[j].fdi,
+                stage,
+                mm,
+            })
+            .collect();
+        let scan_overlap_mm = stager.scan_overlap.values().copied().fold(0.0, f32::max);
+        Plan {
+            case: d.case.case.name.clone(),
+            stages: n,
+            limits: limits.clone(),
+            target: target.source,
+            setup: target.arches.clone(),
+            ipr,
+            teeth,
+            max_penetration_mm: max_excess,
+            scan_overlap_mm,
+            blocked: stager.blocked,
+            measures: stager.measures,
+            rounds,
+            target_ms,
+            plan_ms: started.elapsed().as_secs_f64() * 1e3,
+            moves: stager.moves,
+        }
+    }
+}
