@@ -12,8 +12,10 @@
 //! whose surfaces are farther apart than the rest of the motion can close is done at once
 //! (the bounded query opens nothing beyond that distance).
 //!
-//! Guarantee: every measured instant is exact; between measures the penetration is at most the
-//! deeper of its two ends' plus b (0.01 mm). A plan's `max_penetration_mm` is the deepest
+//! Guarantee: every measured instant is exact (a penetration is the deepest vertex or triangle
+//! centroid of either tooth inside the other, exact when the deepest point is one, and surfaces
+//! that cross with none inside count [`CROSSING_MM`] deep); between measures the penetration is
+//! at most the deeper of its two ends' plus b (0.01 mm). A plan's `max_penetration_mm` is the deepest
 //! measured, and a transition counts as colliding when a measure finds the teeth deeper inside
 //! each other than allowed.
 
@@ -23,6 +25,21 @@ use crate::geometry::{MeshRef, mesh_separation_within};
 /// Gap (mm) within which two teeth count as in contact, and by which their gap may fall between
 /// two measures while they are: the exact stage's tolerance.
 pub const BAND_MM: f32 = GAP_TOLERANCE_MM;
+
+/// Depth (mm) counted for surfaces that cross with no sample point (vertex or triangle centroid)
+/// of either inside the other, where the penetration estimate reads 0: crossing surfaces are
+/// inside each other, however shallow.
+pub const CROSSING_MM: f32 = 1e-3;
+
+/// The signed gap of a measure (mm): the distance when apart, minus the penetration when the
+/// surfaces meet (at least [`CROSSING_MM`]).
+pub fn signed_gap(sep: &crate::geometry::MeshSeparation) -> f32 {
+    if sep.distance > 0.0 {
+        sep.distance
+    } else {
+        -sep.penetration.max(CROSSING_MM)
+    }
+}
 
 /// Most measures of one pair over one transition; beyond it the pair is reported as not
 /// checked (never reached at the per-stage limits, where a touching pair needs a few hundred).
@@ -95,7 +112,7 @@ pub fn transition(a: &Mover, b: &Mover) -> Clearance {
         let Some(sep) = mesh_separation_within(a.mesh, &pa, b.mesh, &pb, reach) else {
             return out;
         };
-        let gap = sep.signed_gap();
+        let gap = signed_gap(&sep);
         if gap < out.least_gap_mm {
             out.least_gap_mm = gap;
             out.at = t as f32;
@@ -114,5 +131,108 @@ pub fn transition(a: &Mover, b: &Mover) -> Clearance {
             band / mu
         };
         t = (t + step).min(1.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+
+    use super::*;
+    use crate::geometry::{Pose, TriMesh, TriangleBvh};
+
+    fn solid(min: Vec3, max: Vec3) -> (TriMesh, TriangleBvh) {
+        let m = TriMesh::cuboid(min, max);
+        let b = TriangleBvh::build(&m);
+        (m, b)
+    }
+
+    fn mover<'a>(s: &'a (TriMesh, TriangleBvh), start: Pose, end: Pose) -> Mover<'a> {
+        let mesh = MeshRef {
+            mesh: &s.0,
+            bvh: &s.1,
+        };
+        Mover::new(mesh, Motion { start, end })
+    }
+
+    fn at(x: f32, y: f32, z: f32) -> Pose {
+        Pose::from_translation(Vec3::new(x, y, z))
+    }
+
+    #[test]
+    fn a_box_passing_through_another_mid_way_is_found() {
+        // Apart by 18 mm at both ends; inside each other for 5 % of the motion.
+        let a = solid(Vec3::splat(-0.5), Vec3::splat(0.5));
+        let b = solid(Vec3::splat(-0.5), Vec3::splat(0.5));
+        let c = transition(
+            &mover(&a, at(-20.0, 0.0, 0.0), at(20.0, 0.0, 0.0)),
+            &mover(&b, Pose::IDENTITY, Pose::IDENTITY),
+        );
+        assert!(c.least_gap_mm < 0.0, "{c:?}");
+        assert!(c.at > 0.45 && c.at < 0.55, "{c:?}");
+        assert!(c.complete);
+    }
+
+    #[test]
+    fn a_turning_bar_sweeping_through_a_box_is_found() {
+        // A 20 mm bar turning 90° about its middle; a box in the way at 45°, clear of the bar
+        // at both ends (the bar's tip passes through it mid-turn).
+        let bar = solid(Vec3::new(-10.0, -0.5, -0.5), Vec3::new(10.0, 0.5, 0.5));
+        let block = solid(Vec3::splat(-0.5), Vec3::splat(0.5));
+        let turn = Pose::new(
+            Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            Vec3::ZERO,
+        );
+        let spot = Quat::from_rotation_y(std::f32::consts::FRAC_PI_4) * Vec3::new(8.0, 0.0, 0.0);
+        let c = transition(
+            &mover(&bar, Pose::IDENTITY, turn),
+            &mover(
+                &block,
+                Pose::from_translation(spot),
+                Pose::from_translation(spot),
+            ),
+        );
+        assert!(c.least_gap_mm < -0.1, "{c:?}");
+    }
+
+    #[test]
+    fn touching_teeth_that_part_never_count_as_inside() {
+        // In contact at the start (2 µm apart, within the band), then 1 mm apart: the band's
+        // small steps, no overlap. (Faces exactly flush read as crossing: see CROSSING_MM.)
+        let a = solid(Vec3::ZERO, Vec3::ONE);
+        let b = solid(Vec3::ZERO, Vec3::ONE);
+        let c = transition(
+            &mover(&a, Pose::IDENTITY, at(-1.0, 0.0, 0.0)),
+            &mover(&b, at(1.002, 0.0, 0.0), at(1.002, 0.0, 0.0)),
+        );
+        assert!(c.least_gap_mm > 0.0 && c.least_gap_mm < 0.0021, "{c:?}");
+        assert!(c.complete && c.measures >= 2, "{c:?}");
+        // Held still in contact: measured once, never inside.
+        let still = transition(
+            &mover(&a, Pose::IDENTITY, Pose::IDENTITY),
+            &mover(&b, at(1.002, 0.0, 0.0), at(1.002, 0.0, 0.0)),
+        );
+        assert_eq!(still.measures, 1);
+        assert!(still.excess(0.0) == 0.0, "{still:?}");
+        // Sliding along each other in contact: never inside, within the band's steps.
+        let slide = transition(
+            &mover(&a, Pose::IDENTITY, at(0.0, 0.0, 0.5)),
+            &mover(&b, at(1.002, 0.0, 0.0), at(1.002, 0.0, 0.0)),
+        );
+        assert!(slide.excess(0.0) == 0.0 && slide.complete, "{slide:?}");
+        assert!(slide.measures as f32 >= 0.5 / BAND_MM, "{slide:?}");
+    }
+
+    #[test]
+    fn crossing_surfaces_with_no_vertex_inside_count_as_inside() {
+        // Two bars crossing edge to edge: no vertex of either inside the other.
+        let a = solid(Vec3::new(-5.0, -0.5, -0.5), Vec3::new(5.0, 0.5, 0.5));
+        let b = solid(Vec3::new(-0.5, -5.0, -0.5), Vec3::new(0.5, 5.0, 0.5));
+        let lift = at(0.0, 0.0, 0.9);
+        let c = transition(
+            &mover(&a, Pose::IDENTITY, Pose::IDENTITY),
+            &mover(&b, lift, lift),
+        );
+        assert!(c.excess(0.0) > 0.0, "{c:?}");
     }
 }

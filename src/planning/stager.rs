@@ -277,13 +277,13 @@ impl<'a> Stager<'a> {
                 continue;
             }
             self.measures += 1;
-            let gap = mesh_separation(
+            let sep = mesh_separation(
                 a.geometry.mesh_ref(),
                 &a.pose,
                 b.geometry.mesh_ref(),
                 &b.pose,
-            )
-            .signed_gap();
+            );
+            let gap = clearance::signed_gap(&sep);
             if gap < 0.0 {
                 self.scan_overlap.insert((i, j), -gap);
             }

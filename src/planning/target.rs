@@ -263,7 +263,7 @@ impl<'a> ArchSetter<'a> {
     /// Signed gap between teeth `i` and `j` at the given poses.
     fn gap(&self, i: usize, pi: &Pose, j: usize, pj: &Pose) -> f32 {
         let (a, b) = (&self.teeth[i].geometry, &self.teeth[j].geometry);
-        mesh_separation(a.mesh_ref(), pi, b.mesh_ref(), pj).signed_gap()
+        super::clearance::signed_gap(&mesh_separation(a.mesh_ref(), pi, b.mesh_ref(), pj))
     }
 
     /// Places every tooth along `curve` (see the module doc): the poses, and how far the last

@@ -17,6 +17,7 @@ mod occlusion_measures;
 mod oracle;
 mod parry_support;
 mod pdl;
+mod plan;
 mod roots;
 mod scans;
 mod schedule;
