@@ -108,9 +108,16 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let pdl = pdl_bench(vertices, 200)?;
     let bite = bite_bench(vertices, 3)?;
     let appliance = orthosim::appliance::bench::appliance_bench(20);
+    let plan = orthosim::planning::bench::plan_bench(vertices, 3)?;
     if progress {
         eprintln!();
     }
+    // The exact stage's single query on the near-contact set of this run.
+    let exact_us = report
+        .methods
+        .iter()
+        .find(|m| m.method == "exact")
+        .map_or(f64::NAN, |m| m.us_per_pair);
     if args.json {
         #[derive(serde::Serialize)]
         struct Output<'a> {
@@ -119,12 +126,25 @@ pub fn run(args: BenchArgs) -> Result<()> {
             pdl: &'a PdlBench,
             bite: &'a BiteBench,
             appliance: &'a orthosim::appliance::bench::ApplianceBench,
+            plan: PlanLine<'a>,
+        }
+        #[derive(serde::Serialize)]
+        struct PlanLine<'a> {
+            #[serde(flatten)]
+            bench: &'a orthosim::planning::bench::PlanBench,
+            exact_query_us: f64,
+            ratio_to_exact_query: f64,
         }
         return print_json(&Output {
             report: &report,
             pdl: &pdl,
             bite: &bite,
             appliance: &appliance,
+            plan: PlanLine {
+                bench: &plan,
+                exact_query_us: exact_us,
+                ratio_to_exact_query: plan.total_ms[1] * 1e3 / exact_us.max(1e-9),
+            },
         });
     }
     let tree = args.trees.tree;
@@ -190,6 +210,21 @@ pub fn run(args: BenchArgs) -> Result<()> {
         a.step_iterations,
         a.step_us[1] / report.full_mouth_step_us.max(1e-9),
         a.engage_us[1]
+    );
+    println!(
+        "plan ({} teeth of the crowded lower arch, {} triangles per tooth, {} stages, {} runs): set-up and staging {:.0} ms (median; {:.0}–{:.0}; target {:.0} ms, stages and checks {:.0} ms, {} exact distance queries), {:.0}× the exact stage's single query ({:.1} µs)",
+        plan.teeth,
+        plan.triangles_per_tooth,
+        plan.stages,
+        plan.runs,
+        plan.total_ms[1],
+        plan.total_ms[0],
+        plan.total_ms[2],
+        plan.target_ms[1],
+        plan.plan_ms[1],
+        plan.measures,
+        plan.total_ms[1] * 1e3 / exact_us.max(1e-9),
+        exact_us
     );
     Ok(())
 }

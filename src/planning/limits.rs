@@ -125,7 +125,7 @@ impl Default for PlanLimits {
             ipr: IprLimits::default(),
             expansion_mm: NonNegative(2.0),
             proclination_mm: NonNegative(1.0),
-            contact_gap_mm: NonNegative(0.03),
+            contact_gap_mm: NonNegative(0.04),
             tolerance_mm: NonNegative(0.0),
             sequence: Sequence::AllAtOnce,
             wait: ToothMap::default(),

@@ -21,6 +21,7 @@
 //! | the stager: sequencing, checks, waits and IPR | [`stager`] |
 //! | plan.json and stage meshes | [`export`] |
 
+pub mod bench;
 pub mod clearance;
 pub mod export;
 pub mod limits;

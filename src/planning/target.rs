@@ -361,7 +361,7 @@ impl<'a> ArchSetter<'a> {
         let mut left = crowding;
         let (mut expansion, mut proclination) = (0.0f32, 0.0f32);
         let slack = CROWDING_SLACK_MM;
-        // Expansion, then proclination: the least that relieves the crowding (bisection).
+        // Expansion, then proclination: about the least that relieves the crowding.
         for means in 0..2 {
             if worst(left) <= slack {
                 break;
@@ -381,17 +381,29 @@ impl<'a> ArchSetter<'a> {
                     attempt(expansion, v, &cuts)
                 }
             };
+            // The crowding falls nearly linearly with either means: secant steps from none and
+            // the limit, each kept only when it relieves the crowding.
             let full = with(limit);
-            let (mut lo, mut hi, mut best) = (0.0f32, limit, full);
+            let (mut lo, mut f_lo) = (0.0f32, worst(left));
+            let (mut hi, mut best) = (limit, full);
             if worst(best.1) <= slack {
-                for _ in 0..6 {
-                    let mid = 0.5 * (lo + hi);
-                    let r = with(mid);
+                for _ in 0..3 {
+                    let f_hi = worst(best.1);
+                    if f_lo - f_hi <= 1e-6 {
+                        break;
+                    }
+                    // Aim a little inside the slack so the step usually lands within it.
+                    let aim = 0.5 * slack;
+                    let v = (lo + (hi - lo) * (f_lo - aim) / (f_lo - f_hi)).clamp(lo, hi);
+                    if hi - v < 0.02 {
+                        break;
+                    }
+                    let r = with(v);
                     if worst(r.1) <= slack {
-                        hi = mid;
+                        hi = v;
                         best = r;
                     } else {
-                        lo = mid;
+                        (lo, f_lo) = (v, worst(r.1));
                     }
                 }
             }

@@ -390,3 +390,33 @@ fn a_scanned_crowded_arch_at_scan_resolution_plans_clean() {
     assert!(t42.total_deg > 12.0, "{}", t42.total_deg);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn scanned_crowns_take_their_axes_from_the_fitted_template() {
+    // The normal arches as scan-like crowns, one file per tooth: every crown with a template
+    // root stands as the arrangement turned it (premolars and molars fit their template about as
+    // well turned half round; the buccal side is the one facing out of the arch).
+    let d = case("normal");
+    let dir = std::env::temp_dir().join(format!("orthosim-plan-axes-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let as_scans = orthosim::teeth::import::ExportMeshes::ScanLike {
+        triangles: 3000,
+        seed: 2,
+    };
+    let report = orthosim::teeth::import::export_case_as(&d, &dir, as_scans).unwrap();
+    let scanned = Dentition::build(Case::load(&report.case_file).unwrap()).unwrap();
+    let mut templates = 0;
+    for t in scanned.visible() {
+        let root = scanned.imported[&t.fdi].root.as_ref().unwrap();
+        if root.kind != "template" {
+            continue;
+        }
+        templates += 1;
+        let anatomical = t.pose.rotation * t.geometry.axes;
+        let truth = d.tooth(t.fdi).unwrap().pose.rotation;
+        let off = anatomical.angle_between(truth).to_degrees();
+        assert!(off < 10.0, "{}: axes {off}° from the arrangement's", t.fdi);
+    }
+    assert!(templates >= 28, "{templates} template roots");
+    let _ = std::fs::remove_dir_all(&dir);
+}

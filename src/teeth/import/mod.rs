@@ -463,7 +463,12 @@ impl Prepared {
         let inverse = pose.inverse();
         let local = self.mesh.map_vertices(|v| inverse.transform_point(v));
         let mut geometry = ToothGeometry::imported(fdi.arch(), fdi.kind(), local);
-        if let Some(r) = self.crown_rotation {
+        if let Some(mut r) = self.crown_rotation {
+            // Premolar and molar crowns fit their template about as well turned half round
+            // their long axis; the crown's buccal side is the one facing out of the arch.
+            if (r * Vec3::Z).dot(pose.rotation * Vec3::Z) < 0.0 {
+                r = Quat::from_axis_angle(r * Vec3::Y, std::f32::consts::PI) * r;
+            }
             geometry.axes = (pose.rotation.inverse() * r).normalize();
         }
         ImportedTooth {
