@@ -50,6 +50,10 @@ pub struct ScreenshotArgs {
     /// Select a tooth (FDI number) in the teeth window, as a click would; repeat for several
     #[arg(long, value_parser = clap::value_parser!(u8).range(11..=48))]
     pub select: Vec<u8>,
+    /// Plan the case in the Plan window once it is ready and show this stage (the last when
+    /// beyond it), the teeth coloured by what they still have to move (implies `--panel`).
+    #[arg(long)]
+    pub plan: Option<u32>,
     /// The PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
@@ -97,8 +101,11 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         frames: args.frames,
         outcome: shared.clone(),
     });
-    if args.panel {
+    if args.panel || args.plan.is_some() {
         app.add_plugins(orthosim::ui::OrthoSimUiPlugin);
+    }
+    if let Some(stage) = args.plan {
+        app.insert_resource(orthosim::ui::PlanRequest { stage });
     }
     app.run();
     let outcome = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -154,6 +161,7 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         args.hide,
         args.out,
         args.panel,
+        args.plan,
         args.select,
     );
     orthosim::teeth::Case::resolve(&args.case)?;

@@ -22,6 +22,9 @@
 //!   its reason).
 //! - **Bite** (`bite`, its own window): settle the lower arch onto the upper, play protrusion or
 //!   a lateral excursion with its guidance and interferences, the contact area per pair.
+//! - **Plan** (`plan`, its own window): plan the case within editable per-stage limits and a
+//!   sequence, step through or play the stages with the teeth coloured by what they still have to
+//!   move and rings where contacts were reduced.
 //!
 //! The camera ignores the mouse while the pointer is over the panel: the plugin makes the view's
 //! [`CameraInputSystems`] run only when egui does not want the pointer.
@@ -30,10 +33,13 @@ mod appliance;
 mod bite;
 mod case;
 mod collision;
+mod plan;
 mod readouts;
 mod simulation;
 mod teeth;
 mod view;
+
+pub use plan::PlanRequest;
 
 use bevy::{
     ecs::{schedule::ScheduleLabel, system::SystemParam},
@@ -65,11 +71,17 @@ impl Plugin for OrthoSimUiPlugin {
             .init_resource::<teeth::LoadEditor>()
             .init_resource::<appliance::ApplianceEditor>()
             .init_resource::<bite::BiteView>()
+            .init_resource::<plan::PlanView>()
             .configure_sets(Update, CameraInputSystems.run_if(pointer_free))
             .add_observer(teeth::click_tooth)
             .add_systems(
                 EguiPrimaryContextPass,
-                (panel, teeth::loads_window, bite::bite_window),
+                (
+                    panel,
+                    teeth::loads_window,
+                    bite::bite_window,
+                    plan::plan_window,
+                ),
             )
             .add_systems(Update, (single_step, clinical_pace));
     }

@@ -173,3 +173,41 @@ fn the_panel_shows_over_the_view_with_a_selected_tooth() {
     assert!(left > 4 * left0.max(10), "left {left} from {left0}");
     assert!(right > 4 * right0.max(10), "right {right} from {right0}");
 }
+
+#[test]
+fn the_plan_window_colours_the_teeth_by_what_they_still_have_to_move() {
+    if !have_xvfb() {
+        return;
+    }
+    // Red crowns: 2 mm or 10° still to go; green: nothing.
+    let count = |buf: &[u8], channels: usize| {
+        let px: Vec<&[u8]> = buf.chunks(channels).collect();
+        let red = px
+            .iter()
+            .filter(|p| p[0] > 150 && p[1] < 100 && p[2] < 100)
+            .count();
+        let green = px
+            .iter()
+            .filter(|p| p[1] as i32 > p[0] as i32 + 30 && p[1] as i32 > p[2] as i32 + 30)
+            .count();
+        (red, green)
+    };
+    let view = [
+        "--case",
+        "crowded",
+        "--view",
+        "mandibular",
+        "--hide",
+        "upper",
+    ];
+    let (_, _, channels, first) = shoot("plan-first", &[&view[..], &["--plan", "0"]].concat());
+    let (_, _, _, last) = shoot("plan-last", &[&view[..], &["--plan", "999"]].concat());
+    let (red0, green0) = count(&first, channels);
+    let (red1, green1) = count(&last, channels);
+    // (The panel's plot draws a few hundred red pixels of its own at every stage.)
+    assert!(
+        red0 > red1 + 1000,
+        "red pixels: {red0} at stage 0, {red1} at the last"
+    );
+    assert!(green1 > green0 + 2000, "green {green0} then {green1}");
+}
