@@ -18,6 +18,7 @@
 //! | [`collision`] | broad phase, narrow phases (circles, spheres, continuous, exact), contact tests | – |
 //! | [`simulation`] | the schedule and the chained [`SimulationSystems`](simulation::SimulationSystems) | `ecs` |
 //! | [`movement`] | loads, wires, the engine-free [`Simulation`](movement::Simulation), responses | – |
+//! | [`planning`] | target set-ups, staging within limits with no tooth through another, IPR, stage meshes | – |
 //! | [`analysis`] | distances, occlusion, IPR, Bolton, reports and plots | – |
 //! | `occlusion_view` | rendering, overlays, contact maps, the orbit camera | `viewer` |
 //! | `ui` | the egui panel | `viewer` |
