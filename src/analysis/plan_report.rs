@@ -177,7 +177,8 @@ pub fn plan_html(plan: &Plan, first: &str, last: &str) -> String {
          th{{background:#eee}}img{{max-width:100%}}</style></head><body>\
          <h1>Plan for {case}</h1><p>{stages} stages ({seq}), target {target}; planned in {ms:.0} ms \
          (target set up in {tms:.0} ms). Deepest penetration beyond what is allowed: {pen:.3} mm. \
-         Deepest overlap in the scan: {scan:.3} mm.</p>",
+         Deepest overlap in the scan: {scan:.3} mm. Deepest overlap between the arches (not \
+         checked between stages): {opp0:.3} mm as scanned, {opp1:.3} mm at the target.</p>",
         case = e(&plan.case),
         stages = plan.stages,
         seq = plan.limits.sequence.name(),
@@ -186,6 +187,8 @@ pub fn plan_html(plan: &Plan, first: &str, last: &str) -> String {
         tms = plan.target_ms,
         pen = plan.max_penetration_mm,
         scan = plan.scan_overlap_mm,
+        opp0 = plan.opposing_overlap_mm[0],
+        opp1 = plan.opposing_overlap_mm[1],
     );
     if !plan.blocked.is_empty() {
         h.push_str("<h2>Blocked</h2><ul>");

@@ -97,9 +97,11 @@ pub fn run(args: PlanArgs) -> Result<()> {
         );
     }
     println!(
-        "deepest penetration beyond what is allowed: {:.3} mm (overlap in the scan: {:.3} mm); files in {}",
+        "deepest penetration beyond what is allowed: {:.3} mm (overlap in the scan: {:.3} mm); between the arches (not checked between stages): {:.3} mm as scanned, {:.3} mm at the target; files in {}",
         p.max_penetration_mm,
         p.scan_overlap_mm,
+        p.opposing_overlap_mm[0],
+        p.opposing_overlap_mm[1],
         args.out.display()
     );
     Ok(())

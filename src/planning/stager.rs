@@ -106,6 +106,10 @@ pub struct Plan {
     pub max_penetration_mm: f32,
     /// Deepest overlap of two teeth in the scan as it stands (mm; 0: none).
     pub scan_overlap_mm: f32,
+    /// Deepest overlap between an upper and a lower tooth (mm; 0: none) with the arches where
+    /// the case places them: as the scan stands, then at the target. The stages do not check
+    /// the opposing arch; this says whether the target's bite closes into itself.
+    pub opposing_overlap_mm: [f32; 2],
     /// Pairs the plan could not take past each other.
     pub blocked: Vec<Blocked>,
     /// Exact distance queries made.
@@ -288,6 +292,28 @@ impl<'a> Stager<'a> {
                 self.scan_overlap.insert((i, j), -gap);
             }
         }
+    }
+
+    /// The deepest overlap between an upper and a lower tooth at stage `k` (mm).
+    fn opposing_overlap(&mut self, k: u32) -> f32 {
+        let mut deepest = 0.0f32;
+        for i in 0..self.teeth.len() {
+            for j in i + 1..self.teeth.len() {
+                let (a, b) = (self.teeth[i], self.teeth[j]);
+                if a.fdi.arch() == b.fdi.arch() {
+                    continue;
+                }
+                let (pa, pb) = (self.moves[i].pose_at(k), self.moves[j].pose_at(k));
+                let ((ca, ra), (cb, rb)) = (self.spheres[i], self.spheres[j]);
+                if pa.transform_point(ca).distance(pb.transform_point(cb)) > ra + rb {
+                    continue;
+                }
+                self.measures += 1;
+                let sep = mesh_separation(a.geometry.mesh_ref(), &pa, b.geometry.mesh_ref(), &pb);
+                deepest = deepest.max(-clearance::signed_gap(&sep));
+            }
+        }
+        deepest
     }
 
     /// Penetration allowed to pair (i, j) during the transition from stage `k`.
@@ -538,6 +564,7 @@ impl<'a> Stager<'a> {
             })
             .collect();
         let scan_overlap_mm = stager.scan_overlap.values().copied().fold(0.0, f32::max);
+        let opposing_overlap_mm = [stager.opposing_overlap(0), stager.opposing_overlap(n)];
         Plan {
             case: d.case.case.name.clone(),
             stages: n,
@@ -548,6 +575,7 @@ impl<'a> Stager<'a> {
             teeth,
             max_penetration_mm: max_excess,
             scan_overlap_mm,
+            opposing_overlap_mm,
             blocked: stager.blocked,
             measures: stager.measures,
             rounds,

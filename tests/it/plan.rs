@@ -200,6 +200,8 @@ fn teeth_that_cannot_pass_get_ipr_within_the_contact_limit_or_are_reported() {
     let p = plan(&d, &target, &limits, 0.0);
     assert!(p.blocked.is_empty(), "{:?}", p.blocked);
     assert_eq!(p.max_penetration_mm, 0.0);
+    // The normal bite as arranged, and with 32 moved along its arch, closes without overlap.
+    assert_eq!(p.opposing_overlap_mm, [0.0, 0.0]);
     let ipr = p
         .ipr
         .iter()
