@@ -206,19 +206,7 @@ pub fn plan_html(plan: &Plan, first: &str, last: &str) -> String {
         h.push_str("</ul>");
     }
     for s in &plan.setup {
-        let _ = write!(
-            h,
-            "<p>{} arch: crowding {:.2} / {:.2} mm (right / left), expansion {:.2} mm, \
-             proclination {:.2} mm, IPR {:.2} mm, unresolved {:.2} / {:.2} mm.</p>",
-            s.arch,
-            s.crowding_mm[0],
-            s.crowding_mm[1],
-            s.expansion_mm,
-            s.proclination_mm,
-            s.ipr_mm,
-            s.unresolved_mm[0],
-            s.unresolved_mm[1]
-        );
+        let _ = write!(h, "<p>{}.</p>", e(&s.summary()));
     }
     h.push_str(
         "<h2>Movement per tooth</h2><table><tr><th>tooth</th><th>total mm</th><th>total °</th>\

@@ -75,17 +75,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         p.measures
     );
     for s in &p.setup {
-        println!(
-            "  {} arch: crowding {:.2} / {:.2} mm (right / left); expansion {:.2} mm, proclination {:.2} mm, IPR {:.2} mm; unresolved {:.2} / {:.2} mm",
-            s.arch,
-            s.crowding_mm[0],
-            s.crowding_mm[1],
-            s.expansion_mm,
-            s.proclination_mm,
-            s.ipr_mm,
-            s.unresolved_mm[0],
-            s.unresolved_mm[1]
-        );
+        println!("  {}", s.summary());
     }
     for x in &p.ipr {
         println!("  IPR {}|{}: {:.2} mm at stage {}", x.a, x.b, x.mm, x.stage);

@@ -85,6 +85,23 @@ pub struct ArchSetup {
     pub unresolved_mm: [f32; 2],
 }
 
+impl ArchSetup {
+    /// One line: the crowding, the means used and what is left.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} arch: crowding {:.2} / {:.2} mm (right / left); expansion {:.2} mm, proclination {:.2} mm, IPR {:.2} mm; unresolved {:.2} / {:.2} mm",
+            self.arch,
+            self.crowding_mm[0],
+            self.crowding_mm[1],
+            self.expansion_mm,
+            self.proclination_mm,
+            self.ipr_mm,
+            self.unresolved_mm[0],
+            self.unresolved_mm[1]
+        )
+    }
+}
+
 /// Where each tooth should end.
 #[derive(Clone, Debug)]
 pub struct Target {

@@ -336,25 +336,21 @@ fn the_plan_command_writes_its_files_and_json() {
             .unwrap()
             .starts_with(b"\x89PNG")
     );
-    // A target file naming a tooth the case lacks is refused on one line naming it.
+    // A target file moving an extracted tooth is refused on one line naming the file and place.
     let target = dir.join("t.ron");
-    std::fs::write(&target, "{\n  18: (translation: (0.1, 0.0, 0.0)),\n}").unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
-        .args(["plan", "--case", "case1", "--target"])
-        .arg(&target)
-        .arg("--out")
-        .arg(dir.join("again"))
-        .output()
-        .unwrap();
+    let plan_to = |text: &str, out: &str| {
+        std::fs::write(&target, text).unwrap();
+        std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
+            .args(["plan", "--case", "case1", "--target"])
+            .arg(&target)
+            .arg("--out")
+            .arg(dir.join(out))
+            .output()
+            .unwrap()
+    };
+    let out = plan_to("{\n  18: (translation: (0.1, 0.0, 0.0)),\n}", "again");
     assert!(out.status.success(), "18 is present in case 1");
-    std::fs::write(&target, "{\n  14: (translation: (0.1, 0.0, 0.0)),\n}").unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
-        .args(["plan", "--case", "case1", "--target"])
-        .arg(&target)
-        .arg("--out")
-        .arg(dir.join("refused"))
-        .output()
-        .unwrap();
+    let out = plan_to("{\n  14: (translation: (0.1, 0.0, 0.0)),\n}", "refused");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("t.ron:2:3: tooth 14 is extracted"),
