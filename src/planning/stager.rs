@@ -30,7 +30,10 @@ use super::moves::ToothMove;
 use super::target::{ArchSetup, Target};
 use crate::collision::Motion;
 use crate::geometry::mesh_separation;
-use crate::teeth::{Arch, Dentition, Fdi, PlacedTooth, arch::ArchCurve};
+use crate::teeth::{
+    Arch, Dentition, Fdi, PlacedTooth,
+    arch::{ArchCurve, molar_relation},
+};
 
 /// Most resolution rounds before the remaining collisions are reported as blocked.
 const MAX_ROUNDS: usize = 2000;
@@ -110,6 +113,11 @@ pub struct Plan {
     /// the case places them: as the scan stands, then at the target. The stages do not check
     /// the opposing arch; this says whether the target's bite closes into itself.
     pub opposing_overlap_mm: [f32; 2],
+    /// The first molars' sagittal relation (mm; the upper mesiobuccal cusp tip ahead of the
+    /// lower buccal groove, 0 in class I, positive towards class II), patient's right then left,
+    /// as scanned and at the target; `None` where a first molar is missing. The automatic target
+    /// does not seek class I yet; this says where it leaves the molars.
+    pub molar_relation_mm: [[Option<f32>; 2]; 2],
     /// Pairs the plan could not take past each other.
     pub blocked: Vec<Blocked>,
     /// Exact distance queries made.
@@ -292,6 +300,23 @@ impl<'a> Stager<'a> {
                 self.scan_overlap.insert((i, j), -gap);
             }
         }
+    }
+
+    /// The first molars' relation at stage `k` (right, left; see [`Plan::molar_relation_mm`]).
+    fn molar_relation(&self, k: u32) -> [Option<f32>; 2] {
+        let at = |n: i64| {
+            let f = Fdi::new(n).ok()?;
+            let i = self.teeth.iter().position(|t| t.fdi == f)?;
+            Some((i, self.moves[i].pose_at(k)))
+        };
+        [(16, 46), (26, 36)].map(|(u, l)| {
+            let ((i, pu), (j, pl)) = (at(u)?, at(l)?);
+            let (gu, gl) = (
+                self.teeth[i].geometry.as_ref(),
+                self.teeth[j].geometry.as_ref(),
+            );
+            Some(molar_relation((gu, &pu), (gl, &pl)))
+        })
     }
 
     /// The deepest overlap between an upper and a lower tooth at stage `k` (mm).
@@ -565,6 +590,7 @@ impl<'a> Stager<'a> {
             .collect();
         let scan_overlap_mm = stager.scan_overlap.values().copied().fold(0.0, f32::max);
         let opposing_overlap_mm = [stager.opposing_overlap(0), stager.opposing_overlap(n)];
+        let molar_relation_mm = [stager.molar_relation(0), stager.molar_relation(n)];
         Plan {
             case: d.case.case.name.clone(),
             stages: n,
@@ -576,6 +602,7 @@ impl<'a> Stager<'a> {
             max_penetration_mm: max_excess,
             scan_overlap_mm,
             opposing_overlap_mm,
+            molar_relation_mm,
             blocked: stager.blocked,
             measures: stager.measures,
             rounds,

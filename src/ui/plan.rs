@@ -1,4 +1,5 @@
-//! The **Plan** window: plan the case from its teeth as they stand to the automatic target
+//! The **Plan** window: plan the case from its teeth where the case places them (not where the
+//! simulation has moved them since) to the automatic target
 //! within editable per-stage limits and a sequence, then step through the stages with a slider
 //! or play them, the teeth coloured by how much they still have to move (green: done, through
 //! yellow, to red: 2 mm or 10° or more) and a ring between two teeth once their contact has been

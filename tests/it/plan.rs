@@ -70,6 +70,14 @@ fn the_crowded_plan_stays_within_the_limits_and_reaches_its_target() {
         let (mm, deg) = apart(&d, m.fdi, &m.pose_at(p.stages), &target.poses[&m.fdi]);
         assert!(mm <= 0.01 && deg <= 0.1, "{}: {mm} mm {deg}° off", m.fdi);
     }
+    // The lower arch's alignment leaves the molars about where they met.
+    for [before, after] in [0, 1].map(|s| p.molar_relation_mm.map(|r| r[s])) {
+        let (before, after) = (before.unwrap(), after.unwrap());
+        assert!(
+            (after - before).abs() < 0.5,
+            "molar relation {before} → {after}"
+        );
+    }
     // The target puts the crowded lower front back where the normal arrangement has it.
     for n in [31, 32, 33, 41, 42, 43] {
         let (mm, deg) = apart(&d, fdi(n), &target.poses[&fdi(n)], &d.setup[&fdi(n)]);
