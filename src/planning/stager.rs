@@ -9,14 +9,17 @@
 //!    (never deeper) and, from the stage its IPR is done, by the enamel removed; beyond that, plus
 //!    `tolerance_mm`, it collides.
 //! 3. The earliest collision is resolved, and the plan checked again (the measures of transitions
-//!    that did not change are kept): a pair whose target needs IPR gets it at the stage before
-//!    the collision; otherwise the tooth that moves into the other waits a stage; a pair still
-//!    colliding at its target, or whose tooth has waited the whole plan, gets IPR at the
-//!    colliding contact in `ipr_step_mm` steps within its limit; failing that the pair is
-//!    reported as blocked, with the stage and depth, and the plan goes on without it.
+//!    that did not change are kept): a pair whose target needs IPR gets it at the stage of the
+//!    collision (done before the teeth move on from it); otherwise one of the two teeth that
+//!    moves in that transition waits a stage, the one whose wait takes the pair's first
+//!    collision furthest (each tooth waits at most as many stages as the plan had before any
+//!    wait); when no wait takes it later, the contact gets IPR in `ipr_step_mm` steps within its
+//!    limit; failing that the pair is reported as blocked, with the stage, depth and reason, and
+//!    the plan goes on without it.
 //!
 //! The opposing arch is not checked: stages move the teeth of one arch among themselves (the
-//! bite open, as it is while aligners are worn).
+//! bite open, as it is while aligners are worn). The plan reports how deep opposing teeth
+//! overlap, and the first molars' relation, as scanned and at the target.
 
 use std::collections::{BTreeMap, HashMap};
 use std::time::Instant;
