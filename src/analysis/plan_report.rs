@@ -13,33 +13,21 @@ use crate::teeth::{Arch, Dentition};
 /// Picture size (pixels).
 const SIZE: (u32, u32) = (1200, 560);
 
-/// How much a tooth still has to move at stage `k`, 0 (done) to 1 (2 mm or 10° or more).
-fn remaining(plan: &Plan, i: usize, k: u32) -> f32 {
-    let m = &plan.moves[i];
-    let (mm, deg) = m.totals();
-    let left = 1.0 - m.fraction_at(k);
-    (left * (mm / 2.0).max(deg / 10.0)).clamp(0.0, 1.0)
+/// The colour (sRGB, 0–1) of how much a tooth still has to move ([`Plan::still_to_move`]):
+/// green for nothing, through yellow, to red.
+pub fn still_to_move_colour(t: f32) -> [f32; 3] {
+    let (g, y, r) = ([0.35, 0.67, 0.35], [0.92, 0.78, 0.24], [0.82, 0.2, 0.16]);
+    let (a, b, f) = if t < 0.5 {
+        (g, y, t * 2.0)
+    } else {
+        (y, r, (t - 0.5) * 2.0)
+    };
+    [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * f.clamp(0.0, 1.0))
 }
 
-/// Colour from green (nothing left) through yellow to red.
 fn colour(t: f32) -> RGBColor {
-    let (g, y, r) = (
-        [90.0, 170.0, 90.0],
-        [235.0, 200.0, 60.0],
-        [210.0, 50.0, 40.0],
-    );
-    let mix = |a: [f32; 3], b: [f32; 3], f: f32| {
-        RGBColor(
-            (a[0] + (b[0] - a[0]) * f) as u8,
-            (a[1] + (b[1] - a[1]) * f) as u8,
-            (a[2] + (b[2] - a[2]) * f) as u8,
-        )
-    };
-    if t < 0.5 {
-        mix(g, y, t * 2.0)
-    } else {
-        mix(y, r, (t - 0.5) * 2.0)
-    }
+    let [r, g, b] = still_to_move_colour(t).map(|c| (c * 255.0) as u8);
+    RGBColor(r, g, b)
 }
 
 /// A triangle seen from the occlusal side: its corners (x, z), its height towards the viewer and
@@ -64,7 +52,7 @@ fn draw_arch<DB: DrawingBackend>(
         }
         let Some(t) = d.tooth(m.fdi) else { continue };
         let pose = m.pose_at(k);
-        let c = colour(remaining(plan, i, k));
+        let c = colour(plan.still_to_move(i, k));
         for j in 0..t.geometry.mesh.triangles.len() {
             let v = t.geometry.mesh.triangle(j).map(|p| pose.transform_point(p));
             let n = (v[1] - v[0]).cross(v[2] - v[0]);

@@ -178,13 +178,7 @@ impl PlanLimits {
         };
         let limits: PlanLimits = ron::from_str(source)
             .map_err(|e| err(e.span.start.line, e.span.start.col, e.code.to_string()))?;
-        let at = |field: &str| {
-            source
-                .lines()
-                .enumerate()
-                .find_map(|(i, l)| l.find(field).map(|c| (i + 1, c + 1)))
-                .unwrap_or((1, 1))
-        };
+        let at = |field: &str| crate::teeth::case::locate(source, field, None);
         let names = [
             "mesiodistal_mm",
             "buccolingual_mm",

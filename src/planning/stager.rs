@@ -32,7 +32,7 @@ use super::limits::{PlanLimits, group};
 use super::moves::ToothMove;
 use super::target::{ArchSetup, Target};
 use crate::collision::Motion;
-use crate::geometry::mesh_separation;
+use crate::geometry::{Pose, Sphere, mesh_separation};
 use crate::teeth::{
     Arch, Dentition, Fdi, PlacedTooth,
     arch::{ArchCurve, molar_relation},
@@ -138,27 +138,23 @@ pub struct Plan {
 
 impl Plan {
     /// Every present tooth's pose at stage `k`.
-    pub fn poses_at(&self, k: u32) -> Vec<(Fdi, crate::geometry::Pose)> {
+    pub fn poses_at(&self, k: u32) -> Vec<(Fdi, Pose)> {
         self.moves.iter().map(|m| (m.fdi, m.pose_at(k))).collect()
+    }
+
+    /// How much tooth `i` (of [`Plan::moves`]) still has to move at stage `k`: 0 when done, 1 for
+    /// 2 mm of crown travel or 10° of rotation or more (what the pictures and the viewer colour).
+    pub fn still_to_move(&self, i: usize, k: u32) -> f32 {
+        let m = &self.moves[i];
+        let (mm, deg) = m.totals();
+        ((1.0 - m.fraction_at(k)) * (mm / 2.0).max(deg / 10.0)).clamp(0.0, 1.0)
     }
 }
 
-/// A tooth's bounding sphere in its local frame.
-fn bounding_sphere(t: &PlacedTooth) -> (Vec3, f32) {
-    let v = &t.geometry.mesh.vertices;
-    let (lo, hi) = v.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    let c = 0.5 * (lo + hi);
-    let r = v.iter().map(|p| p.distance(c)).fold(0.0f32, f32::max);
-    (c, r)
-}
-
-/// The arch's mesial and buccal unit directions at a tooth's place.
-fn arch_axes(d: &Dentition, t: &PlacedTooth) -> [Vec3; 2] {
-    let form = d.arch_forms[if t.fdi.arch() == Arch::Upper { 0 } else { 1 }];
-    let curve = ArchCurve::new(&form);
+/// The arch's mesial and buccal unit directions at a tooth's place on its arch's `curves`
+/// (upper, lower).
+fn arch_axes(curves: &[ArchCurve; 2], t: &PlacedTooth) -> [Vec3; 2] {
+    let curve = &curves[if t.fdi.arch() == Arch::Upper { 0 } else { 1 }];
     let s = curve.project(Vec2::new(t.pose.translation.x, t.pose.translation.z));
     let (_, tangent) = curve.at(s);
     let along = Vec3::new(tangent.x, 0.0, tangent.y);
@@ -198,12 +194,13 @@ pub fn plan(d: &Dentition, target: &Target, limits: &PlanLimits, target_ms: f64)
     let started = Instant::now();
     let teeth: Vec<&PlacedTooth> = d.visible().collect();
     let per_stage = limits.per_stage();
+    let curves = d.arch_forms.map(|f| ArchCurve::new(&f));
     let mut moves: Vec<ToothMove> = teeth
         .iter()
         .map(|t| {
             let end = target.poses.get(&t.fdi).copied().unwrap_or(t.pose);
             let pivot = t.geometry.frame.crown_centre;
-            ToothMove::new(t.fdi, t.pose, end, pivot, arch_axes(d, t), &per_stage)
+            ToothMove::new(t.fdi, t.pose, end, pivot, arch_axes(&curves, t), &per_stage)
         })
         .collect();
     let mut group_stages = [0u32; 4];
@@ -228,7 +225,13 @@ pub fn plan(d: &Dentition, target: &Target, limits: &PlanLimits, target_ms: f64)
         .iter()
         .filter_map(|c| Some((ordered(index(c.a)?, index(c.b)?), c.mm)))
         .collect();
-    let spheres = teeth.iter().map(|t| bounding_sphere(t)).collect();
+    let spheres = teeth
+        .iter()
+        .map(|t| {
+            let s = Sphere::enclosing(&t.geometry.mesh.vertices);
+            (s.centre, s.radius)
+        })
+        .collect();
     let mut s = Stager {
         waited: vec![0; teeth.len()],
         wait_cap: 0,
@@ -278,28 +281,31 @@ impl<'a> Stager<'a> {
         self.moves.iter().map(|m| m.end_stage()).max().unwrap_or(0)
     }
 
+    /// The signed gap (mm, [`clearance::signed_gap`]) of teeth `i` and `j` at the given poses, or
+    /// `None` when their bounding spheres are apart.
+    fn gap_near(&mut self, i: usize, pi: &Pose, j: usize, pj: &Pose) -> Option<f32> {
+        let ((ci, ri), (cj, rj)) = (self.spheres[i], self.spheres[j]);
+        if pi.transform_point(ci).distance(pj.transform_point(cj)) > ri + rj {
+            return None;
+        }
+        self.measures += 1;
+        let (a, b) = (&self.teeth[i].geometry, &self.teeth[j].geometry);
+        Some(clearance::signed_gap(&mesh_separation(
+            a.mesh_ref(),
+            pi,
+            b.mesh_ref(),
+            pj,
+        )))
+    }
+
     /// The overlap of every pair as the scan stands.
     fn measure_scan(&mut self) {
-        for &(i, j) in &self.pairs {
-            let (a, b) = (self.teeth[i], self.teeth[j]);
-            let (ca, ra) = self.spheres[i];
-            let (cb, rb) = self.spheres[j];
-            if a.pose
-                .transform_point(ca)
-                .distance(b.pose.transform_point(cb))
-                > ra + rb
+        for p in 0..self.pairs.len() {
+            let (i, j) = self.pairs[p];
+            let (pi, pj) = (self.teeth[i].pose, self.teeth[j].pose);
+            if let Some(gap) = self.gap_near(i, &pi, j, &pj)
+                && gap < 0.0
             {
-                continue;
-            }
-            self.measures += 1;
-            let sep = mesh_separation(
-                a.geometry.mesh_ref(),
-                &a.pose,
-                b.geometry.mesh_ref(),
-                &b.pose,
-            );
-            let gap = clearance::signed_gap(&sep);
-            if gap < 0.0 {
                 self.scan_overlap.insert((i, j), -gap);
             }
         }
@@ -327,18 +333,13 @@ impl<'a> Stager<'a> {
         let mut deepest = 0.0f32;
         for i in 0..self.teeth.len() {
             for j in i + 1..self.teeth.len() {
-                let (a, b) = (self.teeth[i], self.teeth[j]);
-                if a.fdi.arch() == b.fdi.arch() {
+                if self.teeth[i].fdi.arch() == self.teeth[j].fdi.arch() {
                     continue;
                 }
-                let (pa, pb) = (self.moves[i].pose_at(k), self.moves[j].pose_at(k));
-                let ((ca, ra), (cb, rb)) = (self.spheres[i], self.spheres[j]);
-                if pa.transform_point(ca).distance(pb.transform_point(cb)) > ra + rb {
-                    continue;
+                let (pi, pj) = (self.moves[i].pose_at(k), self.moves[j].pose_at(k));
+                if let Some(gap) = self.gap_near(i, &pi, j, &pj) {
+                    deepest = deepest.max(-gap);
                 }
-                self.measures += 1;
-                let sep = mesh_separation(a.geometry.mesh_ref(), &pa, b.geometry.mesh_ref(), &pb);
-                deepest = deepest.max(-clearance::signed_gap(&sep));
             }
         }
         deepest

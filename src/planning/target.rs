@@ -180,6 +180,9 @@ struct ArchSetter<'a> {
     /// Each position's level above the posterior plane (mm, towards occlusal), as the normal
     /// arrangement stands.
     steps: [f32; 8],
+    /// Each tooth's extent along its local x (mm, at least 1): the first guess of its width
+    /// along the arch.
+    widths: Vec<f32>,
 }
 
 impl<'a> ArchSetter<'a> {
@@ -211,6 +214,13 @@ impl<'a> ArchSetter<'a> {
             midline,
             left,
             steps,
+            widths: teeth
+                .iter()
+                .map(|t| {
+                    let x = t.geometry.mesh.aabb();
+                    (x.max.x - x.min.x).max(1.0)
+                })
+                .collect(),
         };
         s.plane = s.fit_plane();
         s
@@ -291,16 +301,7 @@ impl<'a> ArchSetter<'a> {
         let mut s = vec![0.0f32; n];
         let mut poses = vec![Pose::IDENTITY; n];
         let s_mid = curve.project(self.midline);
-        let width = |i: usize| {
-            let m = &self.teeth[i].geometry.mesh;
-            let (lo, hi) = m
-                .vertices
-                .iter()
-                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v.x), hi.max(v.x))
-                });
-            (hi - lo).max(1.0)
-        };
+        let width = |i: usize| self.widths[i];
         if self.left > 0 && self.left < n {
             // The two teeth either side of the midline, symmetric about it.
             let (r, l) = (self.left - 1, self.left);

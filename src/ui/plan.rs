@@ -12,6 +12,7 @@ use bevy::prelude::*;
 use bevy_egui::{EguiContexts, egui};
 
 use crate::{
+    analysis::plan_report::still_to_move_colour,
     geometry::Pose,
     movement::SimulationState,
     planning::{Plan, PlanLimits, Sequence, automatic, plan},
@@ -50,28 +51,6 @@ pub(super) struct PlanView {
     requested: bool,
 }
 
-fn remaining(p: &Plan, i: usize, k: u32) -> f32 {
-    let m = &p.moves[i];
-    let (mm, deg) = m.totals();
-    ((1.0 - m.fraction_at(k)) * (mm / 2.0).max(deg / 10.0)).clamp(0.0, 1.0)
-}
-
-fn palette_colour(t: f32) -> Color {
-    let (g, y, r) = ([0.35, 0.67, 0.35], [0.92, 0.78, 0.24], [0.82, 0.2, 0.16]);
-    let mix = |a: [f32; 3], b: [f32; 3], f: f32| {
-        Color::srgb(
-            a[0] + (b[0] - a[0]) * f,
-            a[1] + (b[1] - a[1]) * f,
-            a[2] + (b[2] - a[2]) * f,
-        )
-    };
-    if t < 0.5 {
-        mix(g, y, t * 2.0)
-    } else {
-        mix(y, r, (t - 0.5) * 2.0)
-    }
-}
-
 /// The window's system parameters that place and colour the teeth.
 type ToothQuery<'w, 's> = Query<
     'w,
@@ -100,7 +79,10 @@ fn show(
         view.palette = (0..PALETTE)
             .map(|i| {
                 materials.add(StandardMaterial {
-                    base_color: palette_colour(i as f32 / (PALETTE - 1) as f32),
+                    base_color: {
+                        let [r, g, b] = still_to_move_colour(i as f32 / (PALETTE - 1) as f32);
+                        Color::srgb(r, g, b)
+                    },
                     perceptual_roughness: 0.45,
                     reflectance: 0.4,
                     ..default()
@@ -127,7 +109,7 @@ fn show(
                 view.originals
                     .entry(entity)
                     .or_insert_with(|| material.0.clone());
-                let t = remaining(p, i, k);
+                let t = p.still_to_move(i, k);
                 let c = ((t * (PALETTE - 1) as f32).round() as usize).min(PALETTE - 1);
                 material.0 = view.palette[c].clone();
             }

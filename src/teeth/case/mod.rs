@@ -562,7 +562,7 @@ impl LoadedCase {
 
 /// 1-based (line, column) of `token` (a whole word) after the field name `field:`; of the field
 /// itself when the token is not found; (1, 1) when neither is.
-fn locate(source: &str, field: &str, token: Option<&str>) -> (usize, usize) {
+pub fn locate(source: &str, field: &str, token: Option<&str>) -> (usize, usize) {
     let is_word = |c: char| c.is_ascii_alphanumeric() || c == '_';
     let find_word = |from: usize, word: &str| -> Option<usize> {
         let mut start = from;
