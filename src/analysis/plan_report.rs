@@ -196,6 +196,7 @@ pub fn plan_html(plan: &Plan, first: &str, last: &str) -> String {
     for s in &plan.setup {
         let _ = write!(h, "<p>{}.</p>", e(&s.summary()));
     }
+    let _ = write!(h, "<p>{}.</p>", e(&plan.relations_summary()));
     h.push_str(
         "<h2>Movement per tooth</h2><table><tr><th>tooth</th><th>total mm</th><th>total °</th>\
          <th>mesio-distal mm</th><th>bucco-lingual mm</th><th>vertical mm</th><th>rotation °</th>\

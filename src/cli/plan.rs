@@ -94,15 +94,7 @@ pub fn run(args: PlanArgs) -> Result<()> {
         p.opposing_overlap_mm[1],
         args.out.display()
     );
-    let side = |v: Option<f32>| v.map_or("–".to_owned(), |v| format!("{v:.2}"));
-    let [scan, target] = p.molar_relation_mm;
-    println!(
-        "first molars' relation (right / left, 0 is class I): {} / {} mm as scanned, {} / {} mm at the target",
-        side(scan[0]),
-        side(scan[1]),
-        side(target[0]),
-        side(target[1])
-    );
+    println!("{}", p.relations_summary());
     Ok(())
 }
 

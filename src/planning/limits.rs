@@ -3,7 +3,8 @@
 //! defaults are those of clear-aligner planning (`appliances.md`: 0.25 mm mesio-distal and
 //! bucco-lingual, 0.15 mm vertical, 2° rotation and tip, 1° torque per stage; IPR in 0.05 mm
 //! steps); a RON file overrides any of them, e.g. `(mesiodistal_mm: 0.2, sequence: VPattern,
-//! wait: {13: 4})`.
+//! wait: {13: 4}, anchorage: (upper: Maximum))`. The retraction limit (7 mm) is about a first
+//! premolar's width: the most an extraction space lets the incisors go back.
 
 use std::path::Path;
 
@@ -35,6 +36,65 @@ impl Sequence {
             Sequence::AllAtOnce => "all at once",
             Sequence::AnteriorsFirst => "anteriors first",
             Sequence::VPattern => "V-pattern",
+        }
+    }
+}
+
+/// Which teeth close an arch's spaces (extraction spaces, spacing): the anterior teeth
+/// retracting, the posterior teeth coming forward, or both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Anchorage {
+    /// The share that brings canines and first molars nearest class I with the opposing arch's
+    /// target, keeping the incisors' overjet (see [`super::anchorage`]).
+    #[default]
+    Auto,
+    /// The posterior teeth close the spaces; the anterior teeth stay.
+    Minimum,
+    /// Half each.
+    Moderate,
+    /// The anterior teeth retract to close the spaces (within `retraction_mm`); the molars stay.
+    Maximum,
+}
+
+impl Anchorage {
+    /// The share of the spaces closed by anterior retraction, or None for [`Anchorage::Auto`].
+    pub fn retraction_share(self) -> Option<f32> {
+        match self {
+            Anchorage::Auto => None,
+            Anchorage::Minimum => Some(0.0),
+            Anchorage::Moderate => Some(0.5),
+            Anchorage::Maximum => Some(1.0),
+        }
+    }
+
+    /// The name written in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Anchorage::Auto => "auto",
+            Anchorage::Minimum => "minimum",
+            Anchorage::Moderate => "moderate",
+            Anchorage::Maximum => "maximum",
+        }
+    }
+}
+
+/// The anchorage of each arch.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ArchAnchorage {
+    /// Upper arch.
+    pub upper: Anchorage,
+    /// Lower arch.
+    pub lower: Anchorage,
+}
+
+impl ArchAnchorage {
+    /// The anchorage of `arch`.
+    pub fn of(&self, arch: crate::teeth::Arch) -> Anchorage {
+        if arch == crate::teeth::Arch::Upper {
+            self.upper
+        } else {
+            self.lower
         }
     }
 }
@@ -101,6 +161,10 @@ pub struct PlanLimits {
     pub expansion_mm: NonNegative,
     /// How far forward the automatic target's incisors may come to relieve crowding (mm).
     pub proclination_mm: NonNegative,
+    /// How far back the automatic target's incisors may go to close spaces (mm).
+    pub retraction_mm: NonNegative,
+    /// Which teeth close each arch's spaces in the automatic target.
+    pub anchorage: ArchAnchorage,
     /// The gap between neighbours in the automatic target (mm, 0–0.05).
     pub contact_gap_mm: NonNegative,
     /// Penetration allowed between two teeth at any measured instant of the plan (mm), beyond
@@ -125,6 +189,8 @@ impl Default for PlanLimits {
             ipr: IprLimits::default(),
             expansion_mm: NonNegative(2.0),
             proclination_mm: NonNegative(1.0),
+            retraction_mm: NonNegative(7.0),
+            anchorage: ArchAnchorage::default(),
             contact_gap_mm: NonNegative(0.04),
             tolerance_mm: NonNegative(0.0),
             sequence: Sequence::AllAtOnce,

@@ -16,20 +16,24 @@
 //! |---|---|
 //! | limits, sequencing, the limits file | [`limits`] |
 //! | the target: from a file or set up automatically | [`target`] |
+//! | one arch's automatic set-up | [`setup`] |
+//! | canine and molar relations, the anchorage's choice | [`anchorage`] |
 //! | one tooth's movement split into stages | [`moves`] |
 //! | the collision check of a transition | [`clearance`] |
 //! | the stager: sequencing, checks, waits and IPR | [`stager`] |
 //! | plan.json and stage meshes | [`export`] |
 
+pub mod anchorage;
 pub mod bench;
 pub mod clearance;
 pub mod export;
 pub mod limits;
 pub mod moves;
+pub mod setup;
 pub mod stager;
 pub mod target;
 
-pub use limits::{IprLimits, PlanLimits, Sequence};
+pub use limits::{Anchorage, ArchAnchorage, IprLimits, PlanLimits, Sequence};
 pub use stager::{Blocked, Plan, PlanIpr, PlanTooth, plan};
 pub use target::{Target, automatic, from_offsets};
 

@@ -27,16 +27,14 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
+use super::anchorage::Relations;
 use super::clearance::{self, BAND_MM, Clearance, Mover};
 use super::limits::{PlanLimits, group};
 use super::moves::ToothMove;
 use super::target::{ArchSetup, Target};
 use crate::collision::Motion;
 use crate::geometry::{Pose, Sphere, mesh_separation};
-use crate::teeth::{
-    Arch, Dentition, Fdi, PlacedTooth,
-    arch::{ArchCurve, molar_relation},
-};
+use crate::teeth::{Arch, Dentition, Fdi, PlacedTooth, arch::ArchCurve};
 
 /// Most resolution rounds before the remaining collisions are reported as blocked.
 const MAX_ROUNDS: usize = 2000;
@@ -118,9 +116,15 @@ pub struct Plan {
     pub opposing_overlap_mm: [f32; 2],
     /// The first molars' sagittal relation (mm; the upper mesiobuccal cusp tip ahead of the
     /// lower buccal groove, 0 in class I, positive towards class II), patient's right then left,
-    /// as scanned and at the target; `None` where a first molar is missing. The automatic target
-    /// does not seek class I yet; this says where it leaves the molars.
+    /// as scanned and at the target; `None` where a first molar is missing.
     pub molar_relation_mm: [[Option<f32>; 2]; 2],
+    /// The canines' sagittal relation (mm; the upper cusp tip mesial of the embrasure between
+    /// the lower canine and the tooth distal to it, 0 in class I, positive towards class II),
+    /// right then left, as scanned and at the target; `None` where a tooth is missing.
+    pub canine_relation_mm: [[Option<f32>; 2]; 2],
+    /// The central incisors' mean overjet (mm) as scanned and at the target; `None` where it
+    /// cannot be measured.
+    pub overjet_mm: [Option<f32>; 2],
     /// Pairs the plan could not take past each other.
     pub blocked: Vec<Blocked>,
     /// Exact distance queries made.
@@ -148,6 +152,24 @@ impl Plan {
         let m = &self.moves[i];
         let (mm, deg) = m.totals();
         ((1.0 - m.fraction_at(k)) * (mm / 2.0).max(deg / 10.0)).clamp(0.0, 1.0)
+    }
+
+    /// One line: canine and first-molar relations (right / left) and overjet, as scanned and at
+    /// the target.
+    pub fn relations_summary(&self) -> String {
+        let v = |v: Option<f32>| v.map_or("–".to_owned(), |v| format!("{v:.2}"));
+        let pair = |p: [Option<f32>; 2]| format!("{} / {}", v(p[0]), v(p[1]));
+        let [(m0, c0), (m1, c1)] =
+            [0, 1].map(|k| (self.molar_relation_mm[k], self.canine_relation_mm[k]));
+        format!(
+            "relations (right / left, mm; 0 is class I, positive towards class II): canines {} as scanned, {} at the target; first molars {} as scanned, {} at the target; overjet {} mm as scanned, {} mm at the target",
+            pair(c0),
+            pair(c1),
+            pair(m0),
+            pair(m1),
+            v(self.overjet_mm[0]),
+            v(self.overjet_mm[1])
+        )
     }
 }
 
@@ -311,21 +333,15 @@ impl<'a> Stager<'a> {
         }
     }
 
-    /// The first molars' relation at stage `k` (right, left; see [`Plan::molar_relation_mm`]).
-    fn molar_relation(&self, k: u32) -> [Option<f32>; 2] {
-        let at = |n: i64| {
-            let f = Fdi::new(n).ok()?;
-            let i = self.teeth.iter().position(|t| t.fdi == f)?;
-            Some((i, self.moves[i].pose_at(k)))
-        };
-        [(16, 46), (26, 36)].map(|(u, l)| {
-            let ((i, pu), (j, pl)) = (at(u)?, at(l)?);
-            let (gu, gl) = (
-                self.teeth[i].geometry.as_ref(),
-                self.teeth[j].geometry.as_ref(),
-            );
-            Some(molar_relation((gu, &pu), (gl, &pl)))
-        })
+    /// Canine and molar relations at stage `k`.
+    fn relations(&self, d: &Dentition, k: u32) -> Relations {
+        let poses = self
+            .teeth
+            .iter()
+            .zip(&self.moves)
+            .map(|(t, m)| (t.fdi, m.pose_at(k)))
+            .collect();
+        Relations::measure(d, &poses)
     }
 
     /// The deepest overlap between an upper and a lower tooth at stage `k` (mm).
@@ -594,7 +610,10 @@ impl<'a> Stager<'a> {
             .collect();
         let scan_overlap_mm = stager.scan_overlap.values().copied().fold(0.0, f32::max);
         let opposing_overlap_mm = [stager.opposing_overlap(0), stager.opposing_overlap(n)];
-        let molar_relation_mm = [stager.molar_relation(0), stager.molar_relation(n)];
+        let relations = [stager.relations(d, 0), stager.relations(d, n)];
+        let molar_relation_mm = relations.map(|r| r.molar_mm);
+        let canine_relation_mm = relations.map(|r| r.canine_mm);
+        let overjet_mm = relations.map(|r| r.overjet_mm);
         Plan {
             case: d.case.case.name.clone(),
             stages: n,
@@ -607,6 +626,8 @@ impl<'a> Stager<'a> {
             scan_overlap_mm,
             opposing_overlap_mm,
             molar_relation_mm,
+            canine_relation_mm,
+            overjet_mm,
             blocked: stager.blocked,
             measures: stager.measures,
             rounds,

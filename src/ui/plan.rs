@@ -15,7 +15,7 @@ use crate::{
     analysis::plan_report::still_to_move_colour,
     geometry::Pose,
     movement::SimulationState,
-    planning::{Plan, PlanLimits, Sequence, automatic, plan},
+    planning::{Anchorage, Plan, PlanLimits, Sequence, automatic, plan},
     teeth::{ActiveCase, Tooth},
 };
 
@@ -206,6 +206,29 @@ pub(super) fn plan_window(
                 .response
                 .on_hover_text("which teeth start moving first");
             ui.horizontal(|ui| {
+                for (label, value) in [
+                    ("upper", &mut edited.anchorage.upper),
+                    ("lower", &mut edited.anchorage.lower),
+                ] {
+                    egui::ComboBox::from_label(format!("{label} anchorage"))
+                        .selected_text(value.name())
+                        .show_ui(ui, |ui| {
+                            for a in [
+                                Anchorage::Auto,
+                                Anchorage::Minimum,
+                                Anchorage::Moderate,
+                                Anchorage::Maximum,
+                            ] {
+                                ui.selectable_value(value, a, a.name());
+                            }
+                        })
+                        .response
+                        .on_hover_text(
+                            "which teeth close the arch's spaces: minimum, the posterior teeth come forward; maximum, the anterior teeth retract; auto, the share that brings canines and molars nearest class I keeping the overjet",
+                        );
+                }
+            });
+            ui.horizontal(|ui| {
                 compute |= ui
                     .add_enabled(case.is_some(), egui::Button::new("plan"))
                     .on_hover_text("set up the target and stage the case within these limits")
@@ -222,6 +245,7 @@ pub(super) fn plan_window(
                 "{} stages, planned in {:.0} ms (target {:.0} ms); deepest penetration {:.3} mm",
                 p.stages, p.plan_ms, p.target_ms, p.max_penetration_mm
             ));
+            ui.label(p.relations_summary());
             let mut stage = view.stage;
             ui.horizontal(|ui| {
                 let playing = view.playing;

@@ -1,5 +1,6 @@
 //! orthosim integration tests: one test binary (one link of Bevy), one module per topic.
 
+mod anchorage;
 mod appliance;
 mod bite;
 mod bone;

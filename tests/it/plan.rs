@@ -315,6 +315,15 @@ fn the_plan_command_writes_its_files_and_json() {
     ] {
         assert!(v.get(key).is_some(), "no {key}");
     }
+    // The relations, as scanned and at the target, right and left; the set-up's anchorage.
+    for key in ["molar_relation_mm", "canine_relation_mm"] {
+        let r = &v[key];
+        assert!(r[1][0].is_f64() && r[1][1].is_f64(), "{key}: {r}");
+    }
+    assert!(v["overjet_mm"][1].is_f64());
+    let upper = &v["setup"][0];
+    assert_eq!(upper["anchorage"], "auto");
+    assert!(upper["retraction_share"].is_f64() && upper["retraction_mm"].is_f64());
     let stages = v["stages"].as_u64().unwrap();
     let file: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("plan.json")).unwrap()).unwrap();
@@ -339,6 +348,7 @@ fn the_plan_command_writes_its_files_and_json() {
     }
     let html = std::fs::read_to_string(dir.join("plan.html")).unwrap();
     assert!(html.contains("stage_first.png") && html.contains("<table>"));
+    assert!(html.contains("canines") && html.contains("overjet"));
     assert!(
         std::fs::read(dir.join("stage_last.png"))
             .unwrap()

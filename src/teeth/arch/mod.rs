@@ -47,7 +47,7 @@ mod occlusion;
 
 use bisect::{bisect_clamped, solve_increasing};
 pub use form::{ArchCurve, BetaArch};
-pub use occlusion::{Placed, incisor_relation, measure_occlusion, molar_relation};
+pub use occlusion::{Placed, canine_relation, incisor_relation, measure_occlusion, molar_relation};
 
 /// Parameters of the normal arrangement.
 #[derive(Clone, Debug, PartialEq, Serialize)]

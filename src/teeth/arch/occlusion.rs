@@ -7,7 +7,10 @@
 //! - overjet: from the lower incisor's labial surface, at the height of the upper incisal point,
 //!   forwards to that point;
 //! - molar relation: from the lower first molar's central groove forwards to the upper first
-//!   molar's mesiobuccal cusp tip (0 is class I, positive is mesial of the groove).
+//!   molar's mesiobuccal cusp tip (0 is class I, positive is mesial of the groove);
+//! - canine relation: from the embrasure between the lower canine and the next lower tooth
+//!   distally, mesially along the lower arch, to the upper canine's cusp tip (0 is class I,
+//!   positive is mesial of the embrasure, as in class II).
 
 use glam::Vec3;
 
@@ -54,6 +57,26 @@ pub fn molar_relation(upper: Placed, lower: Placed) -> f32 {
         .unwrap_or(pu.translation);
     let groove = pl.transform_point(Vec3::new(0.0, sl.frame.crown_length, 0.0));
     mesiobuccal.z - groove.z
+}
+
+/// Canine relation (mm, see the module doc) of an upper canine over the lower canine and the
+/// next lower tooth distally (the first premolar, or the second where the first is extracted).
+pub fn canine_relation(upper: Placed, lower: Placed, distal: Placed) -> f32 {
+    let (su, pu) = upper;
+    let (sl, pl) = lower;
+    let (sd, pd) = distal;
+    // The cusp tip farthest towards occlusal (the crown's local +y).
+    let tip = su
+        .cusp_tips
+        .iter()
+        .copied()
+        .max_by(|a, b| a.y.total_cmp(&b.y))
+        .unwrap_or(Vec3::new(0.0, su.frame.crown_length, 0.0));
+    let tip = pu.transform_point(tip);
+    let sep = crate::geometry::mesh_separation(sl.mesh_ref(), pl, sd.mesh_ref(), pd);
+    let embrasure = 0.5 * (sep.point_a + sep.point_b);
+    let mesial = (pl.translation - pd.translation) * Vec3::new(1.0, 0.0, 1.0);
+    (tip - embrasure).dot(mesial.normalize_or_zero())
 }
 
 /// Overjet, overbite and molar relation of an arrangement (means of both sides).
