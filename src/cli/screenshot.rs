@@ -54,6 +54,10 @@ pub struct ScreenshotArgs {
     /// beyond it), the teeth coloured by what they still have to move (implies `--panel`).
     #[arg(long)]
     pub plan: Option<u32>,
+    /// With `--plan`: show the target being edited, the first `--select`ed tooth with its
+    /// handles and its gaps to the teeth near it.
+    #[arg(long, requires = "plan")]
+    pub edit_target: bool,
     /// The PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
@@ -105,7 +109,10 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         app.add_plugins(orthosim::ui::OrthoSimUiPlugin);
     }
     if let Some(stage) = args.plan {
-        app.insert_resource(orthosim::ui::PlanRequest { stage });
+        app.insert_resource(orthosim::ui::PlanRequest {
+            stage,
+            edit: args.edit_target,
+        });
     }
     app.run();
     let outcome = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -162,6 +169,7 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         args.out,
         args.panel,
         args.plan,
+        args.edit_target,
         args.select,
     );
     orthosim::teeth::Case::resolve(&args.case)?;

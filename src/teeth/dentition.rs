@@ -84,6 +84,35 @@ impl PlacedTooth {
         shift.mul(&about_pivot).mul(&self.pose)
     }
 
+    /// The offset that [`PlacedTooth::offset_pose`] turns into `target`: the inverse of that
+    /// map (exact up to rounding; rotations within ±90° about the buccal axis, beyond which the
+    /// three angles are not unique).
+    pub fn offset_between(&self, target: &Pose) -> CaseOffset {
+        let axes = self.anatomical_axes();
+        let basis = glam::Mat3::from_cols(axes[0], axes[1], axes[2]);
+        let rotation = (target.rotation * self.pose.rotation.inverse()).normalize();
+        // The rotation in the axes' basis; a left-handed basis (mesial along +x) turns the
+        // other way in it.
+        let local = Quat::from_mat3(&(basis.transpose() * glam::Mat3::from_quat(rotation) * basis));
+        let hand = basis.determinant().signum();
+        let (a, b, c) = local.to_euler(glam::EulerRot::XYZ);
+        let pivot = self.crown_centre();
+        let shift = target.translation - pivot - rotation * (self.pose.translation - pivot);
+        let f = |v: f32| crate::teeth::case::Finite(v);
+        CaseOffset {
+            translation: (
+                f(shift.dot(axes[0])),
+                f(shift.dot(axes[1])),
+                f(shift.dot(axes[2])),
+            ),
+            rotation_deg: (
+                f(hand * a.to_degrees()),
+                f(hand * b.to_degrees()),
+                f(hand * c.to_degrees()),
+            ),
+        }
+    }
+
     /// The crown centre in the world frame.
     pub fn crown_centre(&self) -> Vec3 {
         self.pose.transform_point(self.geometry.frame.crown_centre)

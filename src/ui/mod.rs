@@ -22,18 +22,20 @@
 //!   its reason).
 //! - **Bite** (`bite`, its own window): settle the lower arch onto the upper, play protrusion or
 //!   a lateral excursion with its guidance and interferences, the contact area per pair.
-//! - **Plan** (`plan`, its own window): plan the case within editable per-stage limits and a
-//!   sequence, step through or play the stages with the teeth coloured by what they still have to
-//!   move and rings where contacts were reduced.
+//! - **Plan** (`plan`, its own window): plan the case within editable per-stage limits, a
+//!   sequence and anchorage, in the background; step through or play the stages with the teeth
+//!   coloured by what they still have to move and rings where contacts were reduced; edit the
+//!   target with handles on the selected tooth, its gaps measured live (`plan_edit`).
 //!
-//! The camera ignores the mouse while the pointer is over the panel: the plugin makes the view's
-//! [`CameraInputSystems`] run only when egui does not want the pointer.
+//! The camera ignores the mouse while the pointer is over the panel or a target handle is being
+//! dragged: the plugin makes the view's [`CameraInputSystems`] run only then.
 
 mod appliance;
 mod bite;
 mod case;
 mod collision;
 mod plan;
+mod plan_edit;
 mod readouts;
 mod simulation;
 mod teeth;
@@ -72,7 +74,10 @@ impl Plugin for OrthoSimUiPlugin {
             .init_resource::<appliance::ApplianceEditor>()
             .init_resource::<bite::BiteView>()
             .init_resource::<plan::PlanView>()
-            .configure_sets(Update, CameraInputSystems.run_if(pointer_free))
+            .configure_sets(
+                Update,
+                CameraInputSystems.run_if(pointer_free.and_then(plan_edit::no_grab)),
+            )
             .add_observer(teeth::click_tooth)
             .add_systems(
                 EguiPrimaryContextPass,
@@ -83,7 +88,10 @@ impl Plugin for OrthoSimUiPlugin {
                     plan::plan_window,
                 ),
             )
-            .add_systems(Update, (single_step, clinical_pace));
+            .add_systems(Update, (single_step, clinical_pace))
+            .init_gizmo_group::<plan_edit::HandleGizmos>()
+            .add_systems(Startup, plan_edit::setup_handle_gizmos)
+            .add_systems(Update, plan_edit::target_handles.before(CameraInputSystems));
     }
 }
 

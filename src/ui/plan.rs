@@ -4,18 +4,24 @@
 //! or play them, the teeth coloured by how much they still have to move (green: done, through
 //! yellow, to red: 2 mm or 10° or more) and a ring between two teeth once their contact has been
 //! reduced (IPR); the plan's stages, IPR, blocked pairs and deepest penetration; back to the case.
-//! Planning pauses the simulation, so the teeth stay where the stage puts them.
+//! Planning pauses the simulation, so the teeth stay where the stage puts them. Planning runs in
+//! the background (a scan-resolution case takes a second or two); the window says so meanwhile.
+//! **edit target** shows the teeth at the target with handles on the selected tooth (see
+//! [`super::plan_edit`]); **plan to this target** stages the edited target.
 
 use std::collections::HashMap;
 
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, egui};
 
+use bevy::tasks::{AsyncComputeTaskPool, Task, futures::check_ready};
+
+use super::plan_edit::{Grip, TargetEditor, gap_colour, nudge, save_target};
 use crate::{
     analysis::plan_report::still_to_move_colour,
     geometry::Pose,
     movement::SimulationState,
-    planning::{Anchorage, Plan, PlanLimits, Sequence, automatic, plan},
+    planning::{Anchorage, Plan, PlanLimits, Sequence, Target, automatic, plan},
     teeth::{ActiveCase, Tooth},
 };
 
@@ -23,11 +29,15 @@ use crate::{
 const PALETTE: usize = 8;
 
 /// Asks the Plan window to open, plan the case once its simulation is ready and show `stage`
-/// (the last when beyond it): what `orthosim screenshot --plan` inserts.
+/// (the last when beyond it), or with `edit` the target with the selected tooth's handles: what
+/// `orthosim screenshot --plan` inserts. A requested plan is computed at once, not in the
+/// background, so that the picture shows it.
 #[derive(Resource, Clone, Copy, Debug)]
 pub struct PlanRequest {
     /// The stage to show.
     pub stage: u32,
+    /// Show the target being edited instead.
+    pub edit: bool,
 }
 
 /// What the window holds between frames.
@@ -37,6 +47,12 @@ pub(super) struct PlanView {
     limits: Option<PlanLimits>,
     /// The plan shown.
     plan: Option<Plan>,
+    /// Its target, edited in place while editing.
+    pub(super) target: Option<Target>,
+    /// The target editor.
+    pub(super) edit: TargetEditor,
+    /// A plan being computed in the background, and when it started.
+    task: Option<(Task<(Target, Plan)>, std::time::Instant)>,
     /// Stage shown.
     stage: u32,
     /// Playing the stages.
@@ -91,12 +107,19 @@ fn show(
             .collect();
     }
     let stage = k.unwrap_or(0);
+    // Editing shows the target as edited.
+    let target = view
+        .target
+        .as_ref()
+        .filter(|_| view.edit.active && k.is_some());
     let mut placed: Vec<(usize, Pose)> = Vec::new();
     for (entity, tooth, mut tf, mut material) in teeth.iter_mut() {
         let Some(i) = p.moves.iter().position(|m| m.fdi == tooth.id) else {
             continue;
         };
-        let pose = p.moves[i].pose_at(stage);
+        let pose = target
+            .and_then(|t| t.poses.get(&tooth.id).copied())
+            .unwrap_or_else(|| p.moves[i].pose_at(stage));
         tf.translation = pose.translation;
         tf.rotation = pose.rotation;
         if let Some(sim) = state.sim.as_ref()
@@ -149,8 +172,28 @@ pub(super) fn plan_window(
     let mut go_to: Option<u32> = None;
     let mut toggle_play = false;
     let mut stop_play = false;
+    let mut toggle_edit = false;
+    let mut plan_edited = false;
+    let mut save = false;
+    let mut nudged: Option<(Grip, f32)> = None;
+    // A background plan that is done.
+    if let Some((task, _)) = view.task.as_mut()
+        && let Some((target, p)) = check_ready(task)
+    {
+        view.task = None;
+        go_to = Some(if view.edit.active { p.stages } else { 0 });
+        view.target = Some(target);
+        view.plan = Some(p);
+        view.stage = 0;
+        view.playing = false;
+        view.edit.changed = false;
+        view.edit.measured = None;
+    }
+    let running = view.task.as_ref().map(|(_, t)| t.elapsed().as_secs_f32());
     let limits = view.limits.get_or_insert_with(PlanLimits::default).clone();
     let mut edited = limits.clone();
+    let editing = view.edit.active;
+    let selected = case.as_ref().and(view.edit.measured.map(|(f, _)| f));
     egui::Window::new("Plan")
         .default_pos([
             ctx.viewport_rect().width() - 360.0,
@@ -159,85 +202,26 @@ pub(super) fn plan_window(
         .default_width(340.0)
         .default_open(asked.is_some())
         .show(ctx, |ui| {
-            egui::Grid::new("plan limits")
-                .num_columns(2)
-                .show(ui, |ui| {
-                    for (label, value, tip) in [
-                        (
-                            "mesio-distal mm",
-                            &mut edited.mesiodistal_mm.0,
-                            "crown movement along the arch per stage",
-                        ),
-                        (
-                            "bucco-lingual mm",
-                            &mut edited.buccolingual_mm.0,
-                            "crown movement across the arch per stage",
-                        ),
-                        (
-                            "vertical mm",
-                            &mut edited.vertical_mm.0,
-                            "intrusion or extrusion per stage",
-                        ),
-                        (
-                            "rotation °",
-                            &mut edited.rotation_deg.0,
-                            "rotation about the vertical per stage",
-                        ),
-                        ("tip °", &mut edited.tip_deg.0, "tip per stage"),
-                        ("torque °", &mut edited.torque_deg.0, "torque per stage"),
-                    ] {
-                        ui.label(label).on_hover_text(tip);
-                        ui.add(egui::DragValue::new(value).range(0.01..=5.0).speed(0.01))
-                            .on_hover_text(tip);
-                        ui.end_row();
-                    }
-                });
-            egui::ComboBox::from_label("sequence")
-                .selected_text(edited.sequence.name())
-                .show_ui(ui, |ui| {
-                    for s in [
-                        Sequence::AllAtOnce,
-                        Sequence::AnteriorsFirst,
-                        Sequence::VPattern,
-                    ] {
-                        ui.selectable_value(&mut edited.sequence, s, s.name());
-                    }
-                })
-                .response
-                .on_hover_text("which teeth start moving first");
-            ui.horizontal(|ui| {
-                for (label, value) in [
-                    ("upper", &mut edited.anchorage.upper),
-                    ("lower", &mut edited.anchorage.lower),
-                ] {
-                    egui::ComboBox::from_label(format!("{label} anchorage"))
-                        .selected_text(value.name())
-                        .show_ui(ui, |ui| {
-                            for a in [
-                                Anchorage::Auto,
-                                Anchorage::Minimum,
-                                Anchorage::Moderate,
-                                Anchorage::Maximum,
-                            ] {
-                                ui.selectable_value(value, a, a.name());
-                            }
-                        })
-                        .response
-                        .on_hover_text(
-                            "which teeth close the arch's spaces: minimum, the posterior teeth come forward; maximum, the anterior teeth retract; auto, the share that brings canines and molars nearest class I keeping the overjet",
-                        );
-                }
-            });
+            limits_ui(ui, &mut edited);
             ui.horizontal(|ui| {
                 compute |= ui
-                    .add_enabled(case.is_some(), egui::Button::new("plan"))
-                    .on_hover_text("set up the target and stage the case within these limits")
+                    .add_enabled(
+                        case.is_some() && running.is_none(),
+                        egui::Button::new("plan"),
+                    )
+                    .on_hover_text("set up the automatic target and stage the case within these limits")
                     .clicked();
                 back = ui
                     .add_enabled(view.plan.is_some(), egui::Button::new("back to the case"))
                     .on_hover_text("the teeth where the case has them, their own colours")
                     .clicked();
             });
+            if let Some(s) = running {
+                ui.horizontal(|ui| {
+                    ui.spinner();
+                    ui.label(format!("planning… {s:.1} s"));
+                });
+            }
             let Some(p) = view.plan.as_ref() else {
                 return;
             };
@@ -247,28 +231,30 @@ pub(super) fn plan_window(
             ));
             ui.label(p.relations_summary());
             let mut stage = view.stage;
-            ui.horizontal(|ui| {
-                let playing = view.playing;
-                if ui
-                    .button(if playing { "pause" } else { "play" })
-                    .on_hover_text("step through the stages, a few a second")
-                    .clicked()
-                {
-                    go_to = Some(if !playing && stage >= p.stages {
-                        0
-                    } else {
-                        stage
-                    });
-                    toggle_play = true;
-                }
-                if ui
-                    .add(egui::Slider::new(&mut stage, 0..=p.stages).text("stage"))
-                    .on_hover_text("the teeth at this stage")
-                    .changed()
-                {
-                    go_to = Some(stage);
-                    stop_play = true;
-                }
+            ui.add_enabled_ui(!editing, |ui| {
+                ui.horizontal(|ui| {
+                    let playing = view.playing;
+                    if ui
+                        .button(if playing { "pause" } else { "play" })
+                        .on_hover_text("step through the stages, a few a second")
+                        .clicked()
+                    {
+                        go_to = Some(if !playing && stage >= p.stages {
+                            0
+                        } else {
+                            stage
+                        });
+                        toggle_play = true;
+                    }
+                    if ui
+                        .add(egui::Slider::new(&mut stage, 0..=p.stages).text("stage"))
+                        .on_hover_text("the teeth at this stage")
+                        .changed()
+                    {
+                        go_to = Some(stage);
+                        stop_play = true;
+                    }
+                });
             });
             for x in &p.ipr {
                 ui.label(format!(
@@ -282,6 +268,61 @@ pub(super) fn plan_window(
                     format!("blocked {}–{} at stage {}: {}", b.a, b.b, b.stage, b.why),
                 );
             }
+            ui.separator();
+            let mut on = editing;
+            if ui
+                .checkbox(&mut on, "edit target")
+                .on_hover_text(
+                    "the teeth at the target; drag the selected tooth's arrows to move it along its mesial (red), buccal (green) and occlusal (blue) axes, its rings to turn it",
+                )
+                .changed()
+            {
+                toggle_edit = true;
+            }
+            if !editing {
+                return;
+            }
+            match selected {
+                Some(f) => {
+                    ui.label(format!("tooth {f}: drag its handles, or step it:"));
+                    nudged = nudge_ui(ui);
+                }
+                None => {
+                    ui.label("select a tooth to move it");
+                }
+            }
+            for c in &view.edit.contacts {
+                let [r, g, b] = gap_colour(c.gap_mm);
+                ui.colored_label(
+                    egui::Color32::from_rgb(r, g, b),
+                    format!(
+                        "{}–{}: {:+.3} mm",
+                        selected.map_or(String::new(), |f| f.to_string()),
+                        c.other,
+                        c.gap_mm
+                    ),
+                )
+                .on_hover_text("exact gap (negative: the teeth overlap)");
+            }
+            ui.horizontal(|ui| {
+                plan_edited = ui
+                    .add_enabled(
+                        view.edit.changed && running.is_none(),
+                        egui::Button::new("plan to this target"),
+                    )
+                    .on_hover_text("stage the case to the target as edited")
+                    .clicked();
+                save = ui
+                    .button("save target")
+                    .on_hover_text(
+                        "write each tooth's movement from where the case has it, for orthosim plan --target",
+                    )
+                    .clicked();
+                ui.text_edit_singleline(&mut view.edit.path);
+            });
+            if let Some(m) = &view.edit.saved {
+                ui.label(m);
+            }
         });
     if toggle_play {
         view.playing = !view.playing;
@@ -292,27 +333,79 @@ pub(super) fn plan_window(
     if edited != limits {
         view.limits = Some(edited);
     }
-    if compute && let Some(case) = case {
+    if toggle_edit {
+        view.edit.active = !view.edit.active;
+        view.edit.measured = None;
+        view.playing = false;
+        go_to = Some(if view.edit.active {
+            view.plan.as_ref().map_or(0, |p| p.stages)
+        } else {
+            view.stage
+        });
+    }
+    if let (Some((handle, amount)), Some(case), Some(f)) = (nudged, case.as_ref(), selected)
+        && let Some(target) = view.target.as_mut()
+    {
+        nudge(target, &case.0, f, handle, amount);
+        view.edit.changed = true;
+    }
+    if save && let Some(case) = case.as_ref() {
+        let view = &mut *view;
+        if view.edit.path.trim().is_empty() {
+            view.edit.path = "target.ron".into();
+        }
+        let path = std::path::PathBuf::from(view.edit.path.trim());
+        if let Some(target) = view.target.as_ref() {
+            view.edit.saved = Some(save_target(&case.0, target, &path));
+        }
+    }
+    if (compute || plan_edited)
+        && let Some(case) = case
+    {
         let limits = view.limits.clone().unwrap_or_default();
         // The simulation holds still while the stages are shown (Play in the panel goes on).
         clock.pause();
         // Teeth and colours back before a new plan replaces the old one.
-        show(&mut view, None, &mut state, &mut teeth, &mut materials);
-        let started = std::time::Instant::now();
-        let target = automatic(&case.0, &limits);
-        let ms = started.elapsed().as_secs_f64() * 1e3;
-        view.plan = Some(plan(&case.0, &target, &limits, ms));
-        view.stage = 0;
-        view.playing = false;
-        go_to = Some(0);
-        if let Some(r) = asked.filter(|_| !view.requested) {
-            view.requested = true;
-            go_to = Some(r.stage.min(view.plan.as_ref().map_or(0, |p| p.stages)));
+        if !plan_edited {
+            show(&mut view, None, &mut state, &mut teeth, &mut materials);
+        }
+        let given = plan_edited
+            .then(|| view.target.clone())
+            .flatten()
+            .map(|mut t| {
+                t.source = "edited";
+                t
+            });
+        let d = case.0.clone();
+        let job = move || {
+            let started = std::time::Instant::now();
+            let target = given.unwrap_or_else(|| automatic(&d, &limits));
+            let ms = started.elapsed().as_secs_f64() * 1e3;
+            let p = plan(&d, &target, &limits, ms);
+            (target, p)
+        };
+        match asked.filter(|_| !view.requested) {
+            Some(r) => {
+                let (target, p) = job();
+                view.requested = true;
+                view.edit.active = r.edit;
+                go_to = Some(r.stage.min(p.stages));
+                view.target = Some(target);
+                view.plan = Some(p);
+                view.stage = 0;
+                view.playing = false;
+            }
+            None => {
+                let task = AsyncComputeTaskPool::get().spawn(async move { job() });
+                view.task = Some((task, std::time::Instant::now()));
+            }
         }
     }
     if back {
         show(&mut view, None, &mut state, &mut teeth, &mut materials);
         view.plan = None;
+        view.target = None;
+        view.edit.active = false;
         view.playing = false;
         return Ok(());
     }
@@ -349,4 +442,104 @@ pub(super) fn plan_window(
         }
     }
     Ok(())
+}
+
+/// The limits, sequence and anchorage, editable.
+fn limits_ui(ui: &mut egui::Ui, edited: &mut PlanLimits) {
+    egui::Grid::new("plan limits")
+        .num_columns(2)
+        .show(ui, |ui| {
+            for (label, value, tip) in [
+                (
+                    "mesio-distal mm",
+                    &mut edited.mesiodistal_mm.0,
+                    "crown movement along the arch per stage",
+                ),
+                (
+                    "bucco-lingual mm",
+                    &mut edited.buccolingual_mm.0,
+                    "crown movement across the arch per stage",
+                ),
+                (
+                    "vertical mm",
+                    &mut edited.vertical_mm.0,
+                    "intrusion or extrusion per stage",
+                ),
+                (
+                    "rotation °",
+                    &mut edited.rotation_deg.0,
+                    "rotation about the vertical per stage",
+                ),
+                ("tip °", &mut edited.tip_deg.0, "tip per stage"),
+                ("torque °", &mut edited.torque_deg.0, "torque per stage"),
+            ] {
+                ui.label(label).on_hover_text(tip);
+                ui.add(egui::DragValue::new(value).range(0.01..=5.0).speed(0.01))
+                    .on_hover_text(tip);
+                ui.end_row();
+            }
+        });
+    egui::ComboBox::from_label("sequence")
+        .selected_text(edited.sequence.name())
+        .show_ui(ui, |ui| {
+            for s in [
+                Sequence::AllAtOnce,
+                Sequence::AnteriorsFirst,
+                Sequence::VPattern,
+            ] {
+                ui.selectable_value(&mut edited.sequence, s, s.name());
+            }
+        })
+        .response
+        .on_hover_text("which teeth start moving first");
+    ui.horizontal(|ui| {
+        for (label, value) in [
+            ("upper", &mut edited.anchorage.upper),
+            ("lower", &mut edited.anchorage.lower),
+        ] {
+            egui::ComboBox::from_label(format!("{label} anchorage"))
+                .selected_text(value.name())
+                .show_ui(ui, |ui| {
+                    for a in [
+                        Anchorage::Auto,
+                        Anchorage::Minimum,
+                        Anchorage::Moderate,
+                        Anchorage::Maximum,
+                    ] {
+                        ui.selectable_value(value, a, a.name());
+                    }
+                })
+                .response
+                .on_hover_text(
+                    "which teeth close the arch's spaces: minimum, the posterior teeth come forward; maximum, the anterior teeth retract; auto, the share that brings canines and molars nearest class I keeping the overjet",
+                );
+        }
+    });
+}
+
+/// Step buttons for the edited tooth's six movements; the one pressed.
+fn nudge_ui(ui: &mut egui::Ui) -> Option<(Grip, f32)> {
+    let mut pressed = None;
+    egui::Grid::new("target nudges")
+        .num_columns(3)
+        .show(ui, |ui| {
+            for (label, handle, step) in [
+                ("mesial mm", Grip::Move(0), 0.1),
+                ("buccal mm", Grip::Move(1), 0.1),
+                ("occlusal mm", Grip::Move(2), 0.1),
+                ("torque °", Grip::Turn(0), 1.0),
+                ("tip °", Grip::Turn(1), 1.0),
+                ("rotation °", Grip::Turn(2), 1.0),
+            ] {
+                ui.label(label);
+                if ui.small_button("−").clicked() {
+                    pressed = Some((handle, -step));
+                }
+                if ui.small_button("+").clicked() {
+                    pressed = Some((handle, step));
+                }
+                ui.end_row();
+            }
+        });
+    pressed
 }

@@ -19,8 +19,13 @@ pub(super) fn click_tooth(
     teeth: Query<(), With<Tooth>>,
     keys: Option<Res<ButtonInput<KeyCode>>>,
     mut selection: ResMut<Selection>,
+    plan: Option<Res<super::plan::PlanView>>,
 ) {
     if click.event.button != PointerButton::Primary || !teeth.contains(click.entity) {
+        return;
+    }
+    // A press that took a target handle ends in no selection.
+    if plan.is_some_and(|p| p.edit.took_press) {
         return;
     }
     let add = keys.is_some_and(|k| k.pressed(KeyCode::ShiftLeft) || k.pressed(KeyCode::ShiftRight));

@@ -436,3 +436,32 @@ fn scanned_crowns_take_their_axes_from_the_fitted_template() {
     assert!(templates >= 28, "{templates} template roots");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_target_pose_turns_back_into_the_offset_that_made_it() {
+    // What the viewer saves when a target is edited: each tooth's offset from where it stands.
+    let d = case("crowded");
+    for (k, t) in d.visible().enumerate() {
+        let v = |i: usize| Finite(((k * 7 + i * 3) % 11) as f32 * 0.3 - 1.5);
+        let o = CaseOffset {
+            translation: (v(0), v(1), v(2)),
+            rotation_deg: (
+                Finite(v(3).0 * 8.0),
+                Finite(v(4).0 * 8.0),
+                Finite(v(5).0 * 8.0),
+            ),
+        };
+        let back = t.offset_between(&t.offset_pose(&o));
+        let pairs = [
+            (o.translation.0, back.translation.0),
+            (o.translation.1, back.translation.1),
+            (o.translation.2, back.translation.2),
+            (o.rotation_deg.0, back.rotation_deg.0),
+            (o.rotation_deg.1, back.rotation_deg.1),
+            (o.rotation_deg.2, back.rotation_deg.2),
+        ];
+        for (a, b) in pairs {
+            assert!((a.0 - b.0).abs() < 2e-3, "{}: {o:?} → {back:?}", t.fdi);
+        }
+    }
+}

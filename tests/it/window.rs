@@ -211,3 +211,30 @@ fn the_plan_window_colours_the_teeth_by_what_they_still_have_to_move() {
     );
     assert!(green1 > green0 + 2000, "green {green0} then {green1}");
 }
+
+#[test]
+fn editing_the_target_draws_the_selected_tooths_handles() {
+    if !have_xvfb() {
+        return;
+    }
+    // Saturated red and blue: the mesial arrow and ring, the occlusal arrow and ring.
+    let handles = |buf: &[u8], channels: usize| {
+        buf.chunks(channels)
+            .enumerate()
+            .filter(|(i, _)| (350..700).contains(&(i % 1280)))
+            .filter(|(_, p)| {
+                (p[0] > 200 && p[1] < 80 && p[2] < 80) || (p[2] > 220 && p[0] < 100 && p[1] < 150)
+            })
+            .count()
+    };
+    let view = [
+        "--case", "crowded", "--view", "left", "--plan", "999", "--select", "33",
+    ];
+    let (_, _, channels, plain) = shoot("edit-off", &view);
+    let (_, _, _, edit) = shoot("edit-on", &[&view[..], &["--edit-target"]].concat());
+    let (off, on) = (handles(&plain, channels), handles(&edit, channels));
+    assert!(
+        on > off + 300,
+        "handle pixels: {off} without editing, {on} with"
+    );
+}
