@@ -40,6 +40,43 @@ impl Sequence {
     }
 }
 
+/// The arch form the automatic target aligns the teeth on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum TargetForm {
+    /// The beta arch fitted to the teeth as they stand.
+    #[default]
+    Fitted,
+    /// A preformed ovoid form, sized to the fitted arch's width at the second molars and depth.
+    Ovoid,
+    /// A preformed tapered form, sized the same way.
+    Tapered,
+    /// A preformed square form, sized the same way.
+    Square,
+}
+
+impl TargetForm {
+    /// The preformed form, or None for the fitted one.
+    pub fn preformed(self) -> Option<crate::teeth::case::appliance::ArchForm> {
+        use crate::teeth::case::appliance::ArchForm;
+        match self {
+            TargetForm::Fitted => None,
+            TargetForm::Ovoid => Some(ArchForm::Ovoid),
+            TargetForm::Tapered => Some(ArchForm::Tapered),
+            TargetForm::Square => Some(ArchForm::Square),
+        }
+    }
+
+    /// The name written in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetForm::Fitted => "fitted",
+            TargetForm::Ovoid => "ovoid",
+            TargetForm::Tapered => "tapered",
+            TargetForm::Square => "square",
+        }
+    }
+}
+
 /// Which teeth close an arch's spaces (extraction spaces, spacing): the anterior teeth
 /// retracting, the posterior teeth coming forward, or both.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -156,6 +193,8 @@ pub struct PlanLimits {
     pub ipr_step_mm: NonNegative,
     /// IPR allowed per contact.
     pub ipr: IprLimits,
+    /// The arch form the automatic target aligns the teeth on.
+    pub arch_form: TargetForm,
     /// How much wider the automatic target's arch form may be than the teeth's (mm, at the
     /// second molars) to relieve crowding.
     pub expansion_mm: NonNegative,
@@ -187,6 +226,7 @@ impl Default for PlanLimits {
             torque_deg: NonNegative(1.0),
             ipr_step_mm: NonNegative(0.05),
             ipr: IprLimits::default(),
+            arch_form: TargetForm::Fitted,
             expansion_mm: NonNegative(2.0),
             proclination_mm: NonNegative(1.0),
             retraction_mm: NonNegative(7.0),

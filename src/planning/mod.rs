@@ -33,7 +33,7 @@ pub mod setup;
 pub mod stager;
 pub mod target;
 
-pub use limits::{Anchorage, ArchAnchorage, IprLimits, PlanLimits, Sequence};
+pub use limits::{Anchorage, ArchAnchorage, IprLimits, PlanLimits, Sequence, TargetForm};
 pub use stager::{Blocked, Plan, PlanIpr, PlanTooth, plan};
 pub use target::{Target, automatic, from_offsets};
 

@@ -7,6 +7,7 @@ use glam::{Mat3, Quat, Vec2, Vec3};
 
 use super::limits::PlanLimits;
 use super::target::{ArchSetup, TargetIpr};
+use crate::appliance::archwire::ArchSize;
 use crate::geometry::{Pose, mesh_separation};
 use crate::teeth::{
     Arch, Dentition, Fdi, PlacedTooth, ShapeSet,
@@ -242,13 +243,33 @@ impl<'a> ArchSetter<'a> {
         }
     }
 
+    /// The curve the teeth are placed along: the arch form of [`Self::form_with`], or the
+    /// chosen preformed form sized to its width and depth.
+    fn curve(&self, expansion: f32, proclination: f32) -> ArchCurve {
+        let f = self.form_with(expansion, proclination);
+        match self.limits.arch_form.preformed() {
+            None => ArchCurve::new(&f),
+            Some(form) => {
+                let size = ArchSize {
+                    molar_width_mm: f64::from(f.width),
+                    depth_mm: f64::from(f.depth),
+                };
+                let back = f.front_z - f.depth;
+                ArchCurve::tabulate(f.width, |x| {
+                    let p = form.point(&size, f64::from(x));
+                    Vec2::new(x, back + p.z as f32)
+                })
+            }
+        }
+    }
+
     /// The arch placed with its crowding relieved (see the module doc).
     pub(super) fn relieve(&self) -> Relieved {
         let n = self.teeth.len();
         let mut cuts = vec![0.0f32; n.saturating_sub(1)];
         let worst = |d: [f32; 2]| d[0].max(d[1]);
         let attempt = |e: f32, p: f32, cuts: &[f32]| {
-            let curve = ArchCurve::new(&self.form_with(e, p));
+            let curve = self.curve(e, p);
             self.place(&curve, cuts)
         };
         let (mut poses, crowding) = attempt(0.0, 0.0, &cuts);
@@ -379,7 +400,7 @@ impl<'a> ArchSetter<'a> {
         if r.has_spaces() && share > 0.0 && limit > 0.0 {
             let goal = (1.0 - share.min(1.0)) * mean(r.left);
             let with = |v: f32| {
-                let curve = ArchCurve::new(&self.form_with(r.expansion, r.proclination - v));
+                let curve = self.curve(r.expansion, r.proclination - v);
                 self.place(&curve, &r.cuts)
             };
             // The last teeth's movement rises nearly linearly with the retraction: secant steps

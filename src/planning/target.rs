@@ -6,8 +6,9 @@
 //!
 //! **Automatic** ([`automatic`]), per arch:
 //! 1. *Arch form*: the beta arch fitted to the present teeth's cervical centres (the case's
-//!    fitted form), the teeth's local origins placed on it as the normal arrangement places
-//!    them.
+//!    fitted form), or the preformed form `arch_form` names (ovoid, tapered, square) sized to its
+//!    width at the second molars and depth; the teeth's local origins placed on it as the normal
+//!    arrangement places them.
 //! 2. *Axes*: each tooth turned to the arrangement's axes at its place on the curve (occlusal
 //!    axis vertical, buccal axis along the curve's outward normal, then the arrangement's crown
 //!    inclination for its position), which corrects rotations, tips and torques. A tooth within

@@ -21,7 +21,7 @@ use crate::{
     analysis::plan_report::still_to_move_colour,
     geometry::Pose,
     movement::SimulationState,
-    planning::{Anchorage, Plan, PlanLimits, Sequence, Target, automatic, plan},
+    planning::{Anchorage, Plan, PlanLimits, Sequence, Target, TargetForm, automatic, plan},
     teeth::{ActiveCase, Tooth},
 };
 
@@ -492,6 +492,20 @@ fn limits_ui(ui: &mut egui::Ui, edited: &mut PlanLimits) {
         })
         .response
         .on_hover_text("which teeth start moving first");
+    egui::ComboBox::from_label("arch form")
+        .selected_text(edited.arch_form.name())
+        .show_ui(ui, |ui| {
+            for f in [
+                TargetForm::Fitted,
+                TargetForm::Ovoid,
+                TargetForm::Tapered,
+                TargetForm::Square,
+            ] {
+                ui.selectable_value(&mut edited.arch_form, f, f.name());
+            }
+        })
+        .response
+        .on_hover_text("the form the target aligns the teeth on: fitted to them, or a preformed one sized to it");
     ui.horizontal(|ui| {
         for (label, value) in [
             ("upper", &mut edited.anchorage.upper),

@@ -465,3 +465,30 @@ fn a_target_pose_turns_back_into_the_offset_that_made_it() {
         }
     }
 }
+
+#[test]
+fn a_chosen_arch_form_sets_the_canines_width() {
+    // Preformed forms sized to the fitted arch: the square form carries its canines widest,
+    // the tapered narrowest; each target is staged without collisions.
+    let d = case("crowded");
+    let width = |form: orthosim::planning::TargetForm| {
+        let limits = PlanLimits {
+            arch_form: form,
+            ..PlanLimits::default()
+        };
+        let (t, p) = planned(&d, &limits);
+        assert!(
+            p.blocked.is_empty() && p.max_penetration_mm == 0.0,
+            "{form:?}: {:?}",
+            p.blocked
+        );
+        let x = |n: i64| t.poses[&fdi(n)].translation.x;
+        x(33) - x(43)
+    };
+    use orthosim::planning::TargetForm::{Ovoid, Square, Tapered};
+    let (tapered, ovoid, square) = (width(Tapered), width(Ovoid), width(Square));
+    assert!(
+        tapered + 0.5 < ovoid && ovoid + 0.5 < square,
+        "{tapered} {ovoid} {square}"
+    );
+}

@@ -33,13 +33,19 @@ pub struct ArchCurve {
 impl ArchCurve {
     /// Tabulates a beta arch (x = W/2 · sin θ, dense where the curve turns backwards).
     pub fn new(form: &BetaArch) -> Self {
+        Self::tabulate(form.width, |x| form.point(x))
+    }
+
+    /// Tabulates any symmetric arch `point(x)` → (x, z) for 0 ≤ x ≤ `width`/2, as [`Self::new`]
+    /// does a beta arch.
+    pub fn tabulate(width: f32, point: impl Fn(f32) -> Vec2) -> Self {
         const N: usize = 1500;
         let mut table = Vec::with_capacity(N + 1);
         let mut s = 0.0;
-        let mut prev = form.point(0.0);
+        let mut prev = point(0.0);
         for i in 0..=N {
             let theta = std::f32::consts::FRAC_PI_2 * i as f32 / N as f32;
-            let p = form.point(0.5 * form.width * theta.sin());
+            let p = point(0.5 * width * theta.sin());
             s += p.distance(prev);
             prev = p;
             table.push((s, p));
