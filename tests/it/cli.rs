@@ -354,8 +354,8 @@ fn medial_trees_fit_tightly_and_come_back_from_the_cache() {
     let first = run();
     let s = &first["summary"];
     assert_eq!(s["all_covered"], true);
-    // The octree at this depth has a mean near 3 (README table); the medial builder must stay far
-    // below it (0.30 in the README table; a polish that lost track of piece corners gave 0.34),
+    // The octree at this depth has a mean near 3 (the guide's table, docs/sphere-trees.md); the medial builder must stay far
+    // below it (0.30 in that table; a polish that lost track of piece corners gave 0.34),
     // and within the budget of 8² leaves.
     let mean = s["sov_sum_mean"].as_f64().unwrap();
     assert!(mean > 0.0 && mean < 0.32, "{s}");

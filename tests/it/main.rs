@@ -6,6 +6,7 @@ mod bite;
 mod bone;
 mod cli;
 mod collision;
+mod docs;
 mod ecs;
 mod fuzz;
 mod geometry_props;

@@ -1,6 +1,6 @@
 //! The PDL model's parameters: the ligament's elasticity and thickness, where the alveolar crest
 //! lies, where the bracket sits, the wire's engagement, and bone remodelling in clinical time.
-//! Defaults and their sources are in the README's "Tooth movement" section.
+//! Defaults and their sources are in the guide's chapter on tooth movement (`docs/movement.md`).
 
 use serde::{Deserialize, Serialize};
 

@@ -68,7 +68,7 @@
 //! leaves. Deterministic: fixed sampling, ties broken by index, no dependence on thread timing.
 //!
 //! Measured on the `normal` case (16 distinct tooth shapes, branching 8, depth 4): `sov_sum` mean
-//! 0.077 (0.060–0.098), about 510 leaves; see the README for the table and the build times.
+//! 0.077 (0.060–0.098), about 510 leaves; see the guide (`docs/sphere-trees.md`) for the table and the build times.
 
 //!
 //! One file per phase: `pieces` (pieces, seeds and the point lattice), `balls` (medial balls),

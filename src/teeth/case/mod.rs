@@ -2,7 +2,7 @@
 //!
 //! Every problem in a case file is reported as one line `file:line:column: problem`: syntax errors,
 //! unknown fields, unknown or duplicate teeth, non-finite numbers, negative sizes, loads on extracted
-//! or absent teeth, absurd load magnitudes. See the README for the schema.
+//! or absent teeth, absurd load magnitudes. See the guide (`docs/cases.md`) for the schema.
 
 pub mod appliance;
 mod parts;
