@@ -2,46 +2,8 @@
 //!
 //! An interactive 3D simulator for orthodontic training and treatment planning: load a patient's
 //! two dental arches, extract teeth, apply loads through an archwire, and watch teeth move and
-//! touch, with exact contacts and distances.
-//!
-//! ## Layers
-//!
-//! Each module uses only the ones above it in this list (a test keeps it so):
-//!
-//! | module | what it is | feature |
-//! |---|---|---|
-//! | [`geometry`] | triangle meshes, spheres, exact triangle queries, BVH, mesh distance | – |
-//! | [`io`] | atomic writes, outputs that never replace inputs, all-or-nothing output sets | – |
-//! | [`parallel`] | the one place that spreads work over cores | – |
-//! | [`teeth`] | FDI numbers, anatomy, procedural teeth, arch forms, cases, mesh import | – |
-//! | [`sphere_tree`] | sphere trees: octree and medial builders, fit, `.sph`, cache | – |
-//! | [`collision`] | broad phase, narrow phases (circles, spheres, continuous, exact), contact tests | – |
-//! | [`simulation`] | the schedule and the chained [`SimulationSystems`](simulation::SimulationSystems) | `ecs` |
-//! | [`movement`] | loads, wires, the engine-free [`Simulation`](movement::Simulation), responses | – |
-//! | [`planning`] | target set-ups, staging within limits with no tooth through another, IPR, stage meshes | – |
-//! | [`analysis`] | distances, occlusion, IPR, Bolton, reports and plots | – |
-//! | `occlusion_view` | rendering, overlays, contact maps, the orbit camera | `viewer` |
-//! | `ui` | the egui panel | `viewer` |
-//!
-//! Without features (`--no-default-features`) the library is the engine-free core, plain Rust on
-//! glam: no Bevy and no clap in its dependency tree. Feature `ecs` adds the Bevy plugins, each a
-//! thin layer over the core; `viewer` adds rendering and the panel; `cli` the `orthosim` command.
-//!
-//! ## Plugins
-//!
-//! | plugin | what it adds |
-//! |---|---|
-//! | `SimulationSchedulePlugin` | the simulation schedule and its chained stages |
-//! | `TeethModelPlugin` | patient cases, tooth entities with shared shapes |
-//! | `SphereTreePlugin` | sphere trees per tooth shape, built in the background |
-//! | `CollisionPlugin` | broad and narrow phases, contacts of moving teeth |
-//! | `MovementPlugin` | loads, wire models, motion per step, block / impulse / IPR responses |
-//! | `OcclusionViewPlugin` (feature `viewer`) | rendering, overlays, orbit camera |
-//! | `OrthoSimUiPlugin` (feature `viewer`) | the egui control panel and readouts |
-//!
-//! `OrthoSimPlugins::new(schedule)` adds the simulation plugins, all in one schedule (default
-//! `FixedUpdate`); the viewer is added separately, so the simulation runs the same with or without
-//! a window. Swap one out with `.build().disable::<…>()` or `.set(…)`: the stages stay ordered.
+//! touch, with exact contacts and distances. The guide (`docs/` in the repository) explains each
+//! part and its figures.
 //!
 //! ## Example: headless, in your own app
 //!
@@ -85,6 +47,45 @@
 //! assert_eq!(exit, AppExit::Success);
 //! # }
 //! ```
+//!
+//! ## Layers
+//!
+//! Each module uses only the ones above it in this list (a test keeps it so):
+//!
+//! | module | what it is | feature |
+//! |---|---|---|
+//! | [`geometry`] | triangle meshes, spheres, exact triangle queries, BVH, mesh distance | – |
+//! | [`io`] | atomic writes, outputs that never replace inputs, all-or-nothing output sets | – |
+//! | [`parallel`] | the one place that spreads work over cores | – |
+//! | [`teeth`] | FDI numbers, anatomy, procedural teeth, arch forms, cases, mesh import | – |
+//! | [`sphere_tree`] | sphere trees: octree and medial builders, fit, `.sph`, cache | – |
+//! | [`collision`] | broad phase, narrow phases (circles, spheres, continuous, exact), contact tests | – |
+//! | [`simulation`] | the schedule and the chained [`SimulationSystems`](simulation::SimulationSystems) | `ecs` |
+//! | [`movement`] | loads, wires, the engine-free [`Simulation`](movement::Simulation), responses | – |
+//! | [`planning`] | target set-ups, staging within limits with no tooth through another, IPR, stage meshes | – |
+//! | [`analysis`] | distances, occlusion, IPR, Bolton, reports and plots | – |
+//! | `occlusion_view` | rendering, overlays, contact maps, the orbit camera | `viewer` |
+//! | `ui` | the egui panel | `viewer` |
+//!
+//! Without features (`--no-default-features`) the library is the engine-free core, plain Rust on
+//! glam: no Bevy and no clap in its dependency tree. Feature `ecs` adds the Bevy plugins, each a
+//! thin layer over the core; `viewer` adds rendering and the panel; `cli` the `orthosim` command.
+//!
+//! ## Plugins
+//!
+//! | plugin | what it adds |
+//! |---|---|
+//! | `SimulationSchedulePlugin` | the simulation schedule and its chained stages |
+//! | `TeethModelPlugin` | patient cases, tooth entities with shared shapes |
+//! | `SphereTreePlugin` | sphere trees per tooth shape, built in the background |
+//! | `CollisionPlugin` | broad and narrow phases, contacts of moving teeth |
+//! | `MovementPlugin` | loads, wire models, motion per step, block / impulse / IPR responses |
+//! | `OcclusionViewPlugin` (feature `viewer`) | rendering, overlays, orbit camera |
+//! | `OrthoSimUiPlugin` (feature `viewer`) | the egui control panel and readouts |
+//!
+//! `OrthoSimPlugins::new(schedule)` adds the simulation plugins, all in one schedule (default
+//! `FixedUpdate`); the viewer is added separately, so the simulation runs the same with or without
+//! a window. Swap one out with `.build().disable::<…>()` or `.set(…)`: the stages stay ordered.
 
 pub mod analysis;
 pub mod appliance;

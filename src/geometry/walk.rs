@@ -47,7 +47,7 @@ pub struct NearContact<'a> {
 ///   their edges or ends within 10⁻⁴ of its length from one of their planes is not trusted, and
 ///   the sample is tested by rays through the whole mesh instead, as every sample is when the
 ///   list is long. The list is kept in runs of nearby triangles under one box each
-///   ([`SegmentTargets`]), so a short segment is tested against few of them.
+///   (`SegmentTargets`), so a short segment is tested against few of them.
 /// - **Depths bounded by the neighbour's.** The distance to a surface changes by at most the
 ///   distance moved, and a segment that enters the other mesh crosses its surface; so a sample's
 ///   depth is at most its inside neighbour's (or bound) plus the segment's length, or the length

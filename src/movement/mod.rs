@@ -3,7 +3,7 @@
 //!
 //! Engine-free core: `settings` (the model choice, mobility and response parameters), `model`
 //! (the paper's load and wire → motion, constraints), [`pdl`] (the periodontal-ligament model),
-//! `arch_path` (sliding along the arch, next present tooth), [`bench`] (the PDL model's costs),
+//! `arch_path` (sliding along the arch, next present tooth), [`mod@bench`] (the PDL model's costs),
 //! [`sim`] (the whole step over a case, with the responses and their guarantees), `report` (the
 //! `simulate` command's measures) and [`MovementError`]. ECS layer (feature `ecs`):
 //! `MovementPlugin`.

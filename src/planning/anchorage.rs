@@ -34,7 +34,7 @@ pub const OVERJET_MAX_MM: f32 = 4.0;
 const RETRACTION_TIE: f32 = 0.05;
 
 /// Canine and first-molar relations and the overjet, as the teeth stand (mm; see
-/// [`crate::teeth::arch::occlusion`] for each measure's sign: 0 is class I, positive class II).
+/// `teeth::arch::occlusion` for each measure's sign: 0 is class I, positive class II).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Relations {
     /// First molars (right, left); None where one is missing.

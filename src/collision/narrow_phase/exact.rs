@@ -63,7 +63,7 @@
 //!
 //! Two ways to search the candidates, the same pairs and the same guarantees. **Flat**
 //! (`flat.rs`, the steps above): every candidate pair listed once and looked at each step, for
-//! sets up to [`FLAT_PAIRS`] pairs (the paper's resolution). **Hierarchical** (`tree.rs`, teeth
+//! sets up to `FLAT_PAIRS` pairs (the paper's resolution). **Hierarchical** (`tree.rs`, teeth
 //! at scan resolution, where the leaf pairs hold up to millions of triangle pairs): each tooth's
 //! candidates form a patch with a hierarchy of its own (the part of the tooth's triangle
 //! hierarchy above them, `patch.rs`), whose boxes are refitted to the candidates alone in a frame

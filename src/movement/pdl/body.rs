@@ -178,7 +178,7 @@ impl PdlBody {
     /// With an appliance's stiffness K the step is backward Euler for the linear part,
     /// v = (I + g·C·K)⁻¹ g·C·w with g = rate·(p − threshold)/p, so that no stiff wire makes the
     /// tooth overshoot where its force falls; that twist is then held to the speed of the
-    /// saturated ligament (its size, rotations weighed at [`TWIST_ARM_MM`], at most that of the
+    /// saturated ligament (its size, rotations weighed at `TWIST_ARM_MM`, at most that of the
     /// undamped twist at `saturation_kpa`). A stiff wire far from passive so moves a tooth at the
     /// ligament's saturated speed, not at the crawl its stiffness alone would allow.
     pub fn twist(&self, w: &Vec6, rate: f64, threshold_kpa: f64, saturation_kpa: f64) -> Vec6 {

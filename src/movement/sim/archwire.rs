@@ -148,7 +148,7 @@ pub struct ArchWire {
     /// Their moment on each bracket about its slot (N·mm, world; from power arms).
     pub chain_moments: Vec<DVec3>,
     /// The slot's friction on each bracket's tooth in the last step (N along the slot's axis;
-    /// see [`super::friction`]).
+    /// see `movement::sim::friction`).
     pub friction_n: Vec<f64>,
 
     /// Wires still to come: the clinical day each is engaged, and the wire.

@@ -126,7 +126,7 @@ pub const MIN_FIT_POINTS: usize = 4;
 impl BetaArch {
     /// The beta arch closest to `points` (x, z; the teeth's cervical centres) in the least-squares
     /// sense over width, depth and front, starting from `self` (Nelder–Mead on the summed squared
-    /// distances to the curve). With fewer than [`MIN_FIT_POINTS`] points, or when the fit is not
+    /// distances to the curve). With fewer than `MIN_FIT_POINTS` points, or when the fit is not
     /// closer by more than 0.01 mm root mean square, `self` is returned. The form stays symmetric about the midline (x = 0).
     pub fn fit(&self, points: &[Vec2]) -> BetaArch {
         if points.len() < MIN_FIT_POINTS || points.iter().any(|p| !p.is_finite()) {

@@ -431,10 +431,10 @@ fn clean_tooth(
     Ok(crown)
 }
 
-/// [`prepare`], and when the repair cannot make a valid solid, the tooth [`rebuild`]t instead.
+/// [`prepare`], and when the repair cannot make a valid solid, the tooth [`rebuild()`]t instead.
 ///
 /// # Errors
-/// What makes the mesh no tooth at all (see [`rebuild`]); the repair's own error when the
+/// What makes the mesh no tooth at all (see [`rebuild()`]); the repair's own error when the
 /// rebuild fails too.
 pub fn prepare_or_rebuild(
     world: &TriMesh,

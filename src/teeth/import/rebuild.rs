@@ -6,7 +6,7 @@
 //! scanned crown (along the arch's apical direction when the margin's own normal does not face the
 //! root's side, as happens where a label runs into the gum). That closed surface may cross itself
 //! anywhere; its winding number does not care. The solid is every point the surface winds around
-//! at least once ([`Columns`], exact along each lattice line), sampled on a grid of
+//! at least once (`Columns`, exact along each lattice line), sampled on a grid of
 //! [`REBUILD_CELL_MM`] with the distance to the surface near it, and its boundary extracted by
 //! marching tetrahedra ([`marching_tetrahedra`]: closed, manifold, outward and free of
 //! self-intersection by construction). Pockets inside the solid are dropped (the largest shell
@@ -70,7 +70,7 @@ pub struct Rebuilt {
 ///
 /// # Errors
 /// Only what makes the mesh no tooth at all: empty, non-finite, no area, a span outside a tooth's
-/// ([`MIN_SPAN_MM`]–[`MAX_SPAN_MM`]), or nothing enclosed.
+/// ([`super::MIN_SPAN_MM`]–[`super::MAX_SPAN_MM`]), or nothing enclosed.
 pub fn rebuild(
     world: &TriMesh,
     fdi: Fdi,

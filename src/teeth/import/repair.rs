@@ -3,11 +3,11 @@
 //! In order: refuse empty meshes, non-finite coordinates and bad indices; weld vertices closer
 //! than [`RepairLimits::weld_mm`]; drop degenerate triangles (a repeated vertex, or an area below
 //! 10⁻¹² of the squared mesh size) and duplicated triangles; drop the triangles of edges shared by
-//! more than two (fins, [`super::mend`]); keep the largest connected piece when the others are
+//! more than two (fins, `mend`); keep the largest connected piece when the others are
 //! debris (each under [`RepairLimits::debris_fraction`] of the triangles), refuse several pieces
 //! otherwise (more than one tooth); make the winding consistent (flipping triangles to agree with
 //! their neighbours, refusing non-orientable surfaces); give each fan of a bow-tie vertex its own
-//! vertex; and smooth spikes. Closing follows in [`super::close`]: every hole but the cervical
+//! vertex; and smooth spikes. Closing follows in `close`: every hole but the cervical
 //! margin is filled, the margin gets a generated root ([`super::root`]), the surface is turned
 //! outward, and places where it meets itself are cut out and closed again until the exact check
 //! ([`TriMesh::validate_solid`]) passes.
@@ -88,7 +88,7 @@ pub struct Repairs {
     /// Length (mm) of the cervical margin closed by a generated root, if one was generated.
     pub root_generated_margin_mm: Option<f32>,
     /// The repair could not make a valid solid, so the tooth was rebuilt from the solid its
-    /// surface encloses ([`super::rebuild`]).
+    /// surface encloses ([`super::rebuild()`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rebuilt: Option<super::rebuild::Rebuilt>,
     /// Which root a scanned crown got, when it got one.

@@ -440,7 +440,7 @@ pub(super) fn star(p: &[DVec2], eps: f64) -> Vec<DVec2> {
     outline
 }
 
-/// Smoothings of [`star`], tried in turn: the least share of the mean angle step that each step
+/// Smoothings of `star`, tried in turn: the least share of the mean angle step that each step
 /// keeps, and the half-width (vertices) of the window each radius is averaged over (capped at
 /// half the outline).
 pub const STAR_SMOOTHING: [(f64, usize); 4] = [
