@@ -58,6 +58,9 @@ pub struct ScreenshotArgs {
     /// handles and its gaps to the teeth near it.
     #[arg(long, requires = "plan")]
     pub edit_target: bool,
+    /// Open the help window (implies `--panel`).
+    #[arg(long)]
+    pub show_help: bool,
     /// The PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
@@ -105,8 +108,11 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         frames: args.frames,
         outcome: shared.clone(),
     });
-    if args.panel || args.plan.is_some() {
+    if args.panel || args.plan.is_some() || args.show_help {
         app.add_plugins(orthosim::ui::OrthoSimUiPlugin);
+    }
+    if args.show_help {
+        app.insert_resource(orthosim::ui::HelpOpen(true));
     }
     if let Some(stage) = args.plan {
         app.insert_resource(orthosim::ui::PlanRequest {
@@ -170,6 +176,7 @@ pub fn run(args: ScreenshotArgs) -> Result<()> {
         args.panel,
         args.plan,
         args.edit_target,
+        args.show_help,
         args.select,
     );
     orthosim::teeth::Case::resolve(&args.case)?;

@@ -81,12 +81,17 @@ pub(super) fn bite_window(
                     ("right", ExcursionKind::Right),
                     ("left", ExcursionKind::Left),
                 ] {
-                    if ui.add_enabled(settled, egui::Button::new(label)).clicked() {
+                    if ui
+                        .add_enabled(settled, egui::Button::new(label))
+                        .on_hover_text("slide the jaw from the bite in 0.5 mm steps")
+                        .clicked()
+                    {
                         start = Some(kind);
                     }
                 }
                 back = ui
                     .add_enabled(settled, egui::Button::new("back to the case"))
+                    .on_hover_text("the teeth where the case placed them")
                     .clicked();
             });
             if let Some(b) = &view.bite {

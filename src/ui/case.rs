@@ -21,12 +21,21 @@ pub(super) fn section(
                 for name in Case::builtin_names() {
                     ui.selectable_value(&mut state.case, name.to_owned(), name);
                 }
-            });
-        if ui.button("Load").clicked() {
+            })
+            .response
+            .on_hover_text("a built-in case (orthosim cases lists them)");
+        if ui
+            .button("Load")
+            .on_hover_text("load the chosen built-in case")
+            .clicked()
+        {
             load.write(LoadCase(state.case.clone()));
         }
         if let Some(name) = current
-            && ui.button("Reset").clicked()
+            && ui
+                .button("Reset")
+                .on_hover_text("load the current case again, its teeth where the case puts them")
+                .clicked()
         {
             load.write(LoadCase(name.to_owned()));
         }
@@ -36,10 +45,12 @@ pub(super) fn section(
             egui::TextEdit::singleline(&mut state.file)
                 .hint_text("case file (.ron)")
                 .desired_width(200.0),
-        );
+        )
+        .on_hover_text("the path of a case file (RON); see docs/cases.md");
         let path = state.file.trim().to_owned();
         if ui
             .add_enabled(!path.is_empty(), egui::Button::new("Load file"))
+            .on_hover_text("load the case file typed beside; an error shows below")
             .clicked()
         {
             load.write(LoadCase(path));

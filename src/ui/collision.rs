@@ -39,7 +39,11 @@ pub(super) fn section(
             for m in Method::ALL {
                 ui.selectable_value(&mut method, m, m.name());
             }
-        });
+        })
+        .response
+        .on_hover_text(
+            "circles: the paper's bounding circles; spheres: sphere trees at the end pose; continuous: swept sphere trees over the step; exact: the triangle meshes, gaps within 0.01 mm",
+        );
     if method != s.collision.method {
         s.collision.method = method;
         if method == Method::Circles {
@@ -53,7 +57,11 @@ pub(super) fn section(
             for r in Response::ALL {
                 ui.selectable_value(&mut response, r, r.name());
             }
-        });
+        })
+        .response
+        .on_hover_text(
+            "what a contact does: block stops the teeth at contact; impulse bounces them; ipr lets them pass, counting the enamel removed",
+        );
     if response != s.movement.response {
         s.movement.response = response;
     }
@@ -64,7 +72,11 @@ pub(super) fn section(
             for m in MovementModel::ALL {
                 ui.selectable_value(&mut model, m, m.name());
             }
-        });
+        })
+        .response
+        .on_hover_text(
+            "pdl: the periodontal ligament moves the teeth in clinical time; paper: the source paper's wire models",
+        );
     if model != s.movement.model {
         s.movement.model = model;
     }
@@ -75,11 +87,19 @@ pub(super) fn section(
             .show_ui(ui, |ui| {
                 ui.selectable_value(&mut chosen.0, TreeMethod::Octree, "Octree");
                 ui.selectable_value(&mut chosen.0, TreeMethod::Medial, "Medial");
-            });
-        ui.add(egui::Slider::new(&mut chosen.1, 2..=6).text("tree depth"));
+            })
+            .response
+            .on_hover_text("the sphere-tree builder: medial fits tighter, octree builds faster");
+        ui.add(egui::Slider::new(&mut chosen.1, 2..=6).text("tree depth"))
+            .on_hover_text("levels of the sphere trees, the root included");
     });
     s.state.tree = Some(chosen);
-    if chosen != (s.trees.method, s.trees.depth) && ui.button("Rebuild trees").clicked() {
+    if chosen != (s.trees.method, s.trees.depth)
+        && ui
+            .button("Rebuild trees")
+            .on_hover_text("build the trees chosen above and restart the case")
+            .clicked()
+    {
         s.trees.method = chosen.0;
         s.trees.depth = chosen.1;
         if let Some(name) = current {

@@ -34,6 +34,7 @@ mod appliance;
 mod bite;
 mod case;
 mod collision;
+mod help;
 mod plan;
 mod plan_edit;
 mod readouts;
@@ -41,6 +42,7 @@ mod simulation;
 mod teeth;
 mod view;
 
+pub use help::HelpOpen;
 pub use plan::PlanRequest;
 
 use bevy::{
@@ -70,6 +72,7 @@ impl Plugin for OrthoSimUiPlugin {
             app.add_plugins(bevy::picking::mesh_picking::MeshPickingPlugin);
         }
         app.init_resource::<PanelState>()
+            .init_resource::<HelpOpen>()
             .init_resource::<teeth::LoadEditor>()
             .init_resource::<appliance::ApplianceEditor>()
             .init_resource::<bite::BiteView>()
@@ -86,6 +89,7 @@ impl Plugin for OrthoSimUiPlugin {
                     teeth::loads_window,
                     bite::bite_window,
                     plan::plan_window,
+                    help::help_window,
                 ),
             )
             .add_systems(Update, (single_step, clinical_pace))
@@ -175,6 +179,7 @@ fn single_step(world: &mut World) {
 #[derive(SystemParam)]
 struct Panel<'w, 's> {
     state: ResMut<'w, PanelState>,
+    help: ResMut<'w, HelpOpen>,
     time: ResMut<'w, Time<Virtual>>,
     real: Res<'w, Time<Real>>,
     collision: ResMut<'w, CollisionSettings>,
@@ -210,6 +215,13 @@ fn panel(mut contexts: EguiContexts, mut p: Panel) -> Result {
         .default_pos([10.0, 10.0])
         .default_width(330.0)
         .show(ctx, |ui| {
+            if ui
+                .small_button("?")
+                .on_hover_text("help: the mouse and keyboard controls (F1)")
+                .clicked()
+            {
+                p.help.0 = !p.help.0;
+            }
             case::section(ui, &mut p.state, current.as_deref(), &mut p.load);
             ui.separator();
             simulation::section(ui, &mut p.state, &mut p.time);

@@ -12,6 +12,7 @@ pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, time: &mut Time
         let paused = time.is_paused();
         if ui
             .button(if paused { "▶ Play" } else { "⏸ Pause" })
+            .on_hover_text("run or hold the simulation clock")
             .clicked()
         {
             if paused {
@@ -20,7 +21,11 @@ pub(super) fn section(ui: &mut egui::Ui, state: &mut PanelState, time: &mut Time
                 time.pause();
             }
         }
-        if ui.add_enabled(paused, egui::Button::new("Step")).clicked() {
+        if ui
+            .add_enabled(paused, egui::Button::new("Step"))
+            .on_hover_text("one simulation step while paused")
+            .clicked()
+        {
             state.step = true;
         }
     });

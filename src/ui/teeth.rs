@@ -120,8 +120,10 @@ pub(super) fn loads_window(
         .default_width(330.0)
         .show(ctx, |ui| {
             chart(ui, &mut selection, &teeth);
-            ui.add(egui::Slider::new(&mut editor.force_n, 0.0..=5.0).text("force N"));
-            ui.add(egui::Slider::new(&mut editor.torque_nmm, 0.0..=50.0).text("torque N·mm"));
+            ui.add(egui::Slider::new(&mut editor.force_n, 0.0..=5.0).text("force N"))
+                .on_hover_text("the magnitude the force presets apply");
+            ui.add(egui::Slider::new(&mut editor.torque_nmm, 0.0..=50.0).text("torque N·mm"))
+                .on_hover_text("the magnitude the torque presets apply");
             loads(ui, &editor, &selection, &teeth, &mut edits.load);
             moment_to_force(ui, &mut editor, &selection, &mut edits.mf);
             wires_and_extraction(ui, &selection, &mut edits);
@@ -158,7 +160,11 @@ fn chart(ui: &mut egui::Ui, selection: &mut ResMut<Selection>, teeth: &WindowTee
                 }
                 let b = ui
                     .add(egui::Button::new(label).small().selected(on))
-                    .on_hover_text(if extracted { "extracted" } else { "" });
+                    .on_hover_text(if extracted {
+                        "extracted; click to select it (restore puts it back)"
+                    } else {
+                        "click to add or remove it from the selection"
+                    });
                 if b.clicked() {
                     selection.pick(e, true);
                 }
@@ -194,6 +200,7 @@ fn loads(
         for (label, f, t) in PRESETS {
             if ui
                 .add_enabled(!selection.0.is_empty(), egui::Button::new(label))
+                .on_hover_text("this load on the selected teeth, along each tooth's own axes")
                 .clicked()
             {
                 chosen = Some((f, t));
@@ -201,6 +208,7 @@ fn loads(
         }
         if ui
             .add_enabled(!selection.0.is_empty(), egui::Button::new("clear"))
+            .on_hover_text("no load on the selected teeth")
             .clicked()
         {
             chosen = Some((None, None));
@@ -244,9 +252,14 @@ fn moment_to_force(
 ) {
     let any = !selection.0.is_empty();
     ui.horizontal_wrapped(|ui| {
-        ui.add(egui::Slider::new(&mut editor.mf_mm, 0.0..=15.0).text("M/F mm"));
+        ui.add(egui::Slider::new(&mut editor.mf_mm, 0.0..=15.0).text("M/F mm"))
+            .on_hover_text("moment-to-force ratio at the bracket: about 10 mm translates a tooth");
         let mut chosen = None;
-        if ui.add_enabled(any, egui::Button::new("set M/F")).clicked() {
+        if ui
+            .add_enabled(any, egui::Button::new("set M/F"))
+            .on_hover_text("give the selected teeth's brackets this moment-to-force ratio")
+            .clicked()
+        {
             chosen = Some(Some(editor.mf_mm));
         }
         if ui
@@ -272,14 +285,26 @@ fn wires_and_extraction(ui: &mut egui::Ui, selection: &Selection, edits: &mut To
             ("round wire", WireModel::Round),
             ("rectangular wire", WireModel::Rectangular),
         ] {
-            if ui.add_enabled(any, egui::Button::new(label)).clicked() {
+            if ui
+                .add_enabled(any, egui::Button::new(label))
+                .on_hover_text("the paper's wire model for the selected teeth")
+                .clicked()
+            {
                 for e in &selection.0 {
                     edits.wire.write(SetWire { tooth: *e, wire });
                 }
             }
         }
         for (label, extracted) in [("extract", true), ("restore", false)] {
-            if ui.add_enabled(any, egui::Button::new(label)).clicked() {
+            if ui
+                .add_enabled(any, egui::Button::new(label))
+                .on_hover_text(if extracted {
+                    "take the selected teeth out while the case runs"
+                } else {
+                    "put them back, unless a neighbour has moved into their place"
+                })
+                .clicked()
+            {
                 for e in &selection.0 {
                     edits.extracted.write(SetExtracted {
                         tooth: *e,

@@ -20,11 +20,19 @@ pub(super) fn section(
     ui.heading("View");
     ui.horizontal(|ui| {
         let mut upper = !overlays.hide_upper;
-        if ui.checkbox(&mut upper, "upper arch").changed() {
+        if ui
+            .checkbox(&mut upper, "upper arch")
+            .on_hover_text("show or hide the upper teeth")
+            .changed()
+        {
             overlays.hide_upper = !upper;
         }
         let mut lower = !overlays.hide_lower;
-        if ui.checkbox(&mut lower, "lower arch").changed() {
+        if ui
+            .checkbox(&mut lower, "lower arch")
+            .on_hover_text("show or hide the lower teeth")
+            .changed()
+        {
             overlays.hide_lower = !lower;
         }
     });
@@ -37,19 +45,28 @@ pub(super) fn section(
                 for l in 0..depth {
                     ui.selectable_value(&mut level, Some(l), l.to_string());
                 }
-            });
+            })
+            .response
+            .on_hover_text("draw one level of every tooth's sphere tree (0: the root sphere)");
         if level != overlays.sphere_level {
             overlays.sphere_level = level;
         }
     });
     ui.horizontal(|ui| {
         let mut show_contacts = overlays.contacts;
-        if ui.checkbox(&mut show_contacts, "contacts").changed() {
+        if ui
+            .checkbox(&mut show_contacts, "contacts")
+            .on_hover_text(
+                "the step's contacts: overlapping leaf spheres orange, contact points red",
+            )
+            .changed()
+        {
             overlays.contacts = show_contacts;
         }
         let mut map = overlays.occlusion_map;
         if ui
             .checkbox(&mut map, "occlusion map (red 0 to blue 0.5 mm)")
+            .on_hover_text("each tooth surface coloured by its exact distance to the opposing arch")
             .changed()
         {
             overlays.occlusion_map = map;
@@ -63,7 +80,9 @@ pub(super) fn section(
                 for r in Roots::ALL {
                     ui.selectable_value(&mut roots, r, r.name());
                 }
-            });
+            })
+            .response
+            .on_hover_text("how the roots are drawn: translucent, solid or hidden");
         if roots != overlays.roots {
             overlays.roots = roots;
         }
@@ -73,6 +92,7 @@ pub(super) fn section(
                 method == Method::Circles,
                 egui::Checkbox::new(&mut circles, "bounding circles"),
             )
+            .on_hover_text("the paper's bounding circles at crown height, red where two meet")
             .on_disabled_hover_text("drawn while the circles algorithm is active")
             .changed()
         {

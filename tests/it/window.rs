@@ -238,3 +238,26 @@ fn editing_the_target_draws_the_selected_tooths_handles() {
         "handle pixels: {off} without editing, {on} with"
     );
 }
+
+#[test]
+fn the_help_window_shows_over_the_view() {
+    if !have_xvfb() {
+        return;
+    }
+    // The help window sits in the middle of the window: egui's dark grey over the teeth.
+    let dark = |buf: &[u8], channels: usize| {
+        buf.chunks(channels)
+            .enumerate()
+            .filter(|(i, _)| (400..880).contains(&(i % 1280)) && (200..520).contains(&(i / 1280)))
+            .filter(|(_, p)| (20..40).contains(&p[0]) && p[0] == p[1] && p[1] == p[2])
+            .count()
+    };
+    let view = ["--case", "normal", "--view", "frontal", "--panel"];
+    let (_, _, channels, plain) = shoot("help-off", &view);
+    let (_, _, _, help) = shoot("help-on", &[&view[..], &["--show-help"]].concat());
+    let (off, on) = (dark(&plain, channels), dark(&help, channels));
+    assert!(
+        on > off + 40_000,
+        "dark grey pixels: {off} without help, {on} with"
+    );
+}
