@@ -36,5 +36,5 @@ shot viewer.png --case normal --view mandibular --hide upper --panel --overlay o
 shot plan.png --case crowded --view mandibular --hide upper --plan 5 --frames 30
 # A target being edited: 33's handles and its gaps to its neighbours.
 shot edit-target.png --case crowded --view left --plan 999 --select 33 --edit-target --frames 30
-# The contacts of the paper's case 1 under the exact stage (Figure 6).
+# The paper's case 1 from the right under the exact stage, its contacts marked (Figure 6).
 shot contacts.png --case case1 --view right --algorithm exact --overlay contacts --frames 120
