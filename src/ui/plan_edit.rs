@@ -261,6 +261,10 @@ pub(super) fn target_handles(
     mut gizmos: Gizmos<HandleGizmos>,
 ) {
     let view = &mut *view;
+    // Each press starts untaken; a handle below takes it.
+    if buttons.just_pressed(MouseButton::Left) {
+        view.edit.took_press = false;
+    }
     if !view.edit.active || view.target.is_none() {
         view.edit.grab = None;
         view.edit.measured = None;
@@ -317,7 +321,6 @@ pub(super) fn target_handles(
     let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
     if buttons.just_pressed(MouseButton::Left) {
-        view.edit.took_press = false;
         if let Some(at) = cursor.filter(|_| !egui_wants && !shift) {
             let best = handles
                 .clone()
