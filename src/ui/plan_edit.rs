@@ -320,17 +320,17 @@ pub(super) fn target_handles(
         .chain([0, 1, 2].map(Grip::Turn));
     let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
-    if buttons.just_pressed(MouseButton::Left) {
-        if let Some(at) = cursor.filter(|_| !egui_wants && !shift) {
-            let best = handles
-                .clone()
-                .filter_map(|h| Some((h, near(h, at)?)))
-                .filter(|(_, px)| *px <= GRAB_PX)
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some((handle, _)) = best {
-                view.edit.grab = Some(Grab { handle, cursor: at });
-                view.edit.took_press = true;
-            }
+    if buttons.just_pressed(MouseButton::Left)
+        && let Some(at) = cursor.filter(|_| !egui_wants && !shift)
+    {
+        let best = handles
+            .clone()
+            .filter_map(|h| Some((h, near(h, at)?)))
+            .filter(|(_, px)| *px <= GRAB_PX)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((handle, _)) = best {
+            view.edit.grab = Some(Grab { handle, cursor: at });
+            view.edit.took_press = true;
         }
     }
     if !buttons.pressed(MouseButton::Left) {
