@@ -378,3 +378,46 @@ fn scan_resolution_crowns_once_refused_import() {
         );
     }
 }
+
+#[test]
+fn steep_necked_lower_incisors_that_trimming_leaves_crossing_import_by_their_repair() {
+    // Lower incisors scanned with 4.9–5.5 mm deep scallops, whose folded margins the trimming
+    // leaves crossing the root: the repair closes them on the whole margin instead, cutting out
+    // the crossings (at most a quarter of the crown), not through the rebuild.
+    let d = normal();
+    for (n, seed, triangles, scallop) in [(32u8, 32u64, 1952, 4.88), (41, 10, 2510, 5.53)] {
+        let fdi = Fdi::new(i64::from(n)).unwrap();
+        let t = d.tooth(fdi).unwrap();
+        let mut defects = ScanDefects::typical(seed * 100 + u64::from(n));
+        defects.scallop_mm = scallop;
+        let crown = scan_like_crown(
+            fdi.arch(),
+            fdi.kind(),
+            &t.pose,
+            triangles,
+            &defects,
+            seed * 7 + u64::from(n),
+        );
+        let guide = orthosim::teeth::import::RootGuide {
+            guess: Some(t.pose),
+            ..Default::default()
+        };
+        let p = orthosim::teeth::import::prepare_guided(
+            &crown.mesh,
+            fdi,
+            &RepairLimits::default(),
+            guide,
+        )
+        .unwrap_or_else(|e| panic!("{n}: {e}"));
+        assert!(p.mesh.validate().is_ok(), "{n}");
+        let r = &p.repairs;
+        assert!(r.root.is_some(), "{n}: a root");
+        assert_eq!(r.margin_trimmed, 0, "{n}: closed untrimmed");
+        assert!(
+            r.triangles_cut as f32 <= 0.25 * crown.mesh.triangles.len() as f32,
+            "{n}: cut {} of {}",
+            r.triangles_cut,
+            crown.mesh.triangles.len()
+        );
+    }
+}

@@ -64,7 +64,8 @@ pub(super) enum RootChoice {
     Cone,
 }
 
-/// Closes `crown` (clean, consistently wound, possibly open) into a solid.
+/// Closes `crown` (clean, consistently wound, possibly open) into a solid, trimming a folded
+/// margin for at most `max_trims` rounds first.
 pub(super) fn close(
     mut crown: TriMesh,
     fdi: Fdi,
@@ -72,6 +73,7 @@ pub(super) fn close(
     limits: &RepairLimits,
     repairs: &mut Repairs,
     choice: RootChoice,
+    max_trims: usize,
 ) -> Result<Closed, ImportError> {
     // The template and its fit, once the margin is known (None: the cone, and why).
     let mut fitted: Option<Result<(std::sync::Arc<Template>, template::Fit), NoTemplate>> = None;
@@ -125,7 +127,7 @@ pub(super) fn close(
         // A margin that folds over itself seen from the root's side (a jagged gum line on a
         // steep wall) loses the triangles hanging at the folds first, while rounds remain.
         if let Some(m) = margin
-            && trims < MAX_TRIMS
+            && trims < max_trims
         {
             let folds = match guide {
                 Some((t, f)) => {

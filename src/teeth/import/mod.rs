@@ -322,6 +322,9 @@ pub fn prepare(world: &TriMesh, fdi: Fdi, limits: &RepairLimits) -> Result<Prepa
     prepare_guided(world, fdi, limits, RootGuide::default())
 }
 
+/// The share of a crown's triangles the untrimmed retry of [`prepare_guided`] may cut out.
+pub const UNTRIMMED_CUT_FRACTION: f32 = 0.25;
+
 /// How a scanned crown's template root is placed: where the fit starts, and how the fitted root
 /// is then turned and shortened (to keep it out of its neighbours' roots).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -373,35 +376,67 @@ pub fn prepare_guided(
     let crown = clean_tooth(world, limits, &mut repairs)?;
     let cleaned = repairs.clone();
     let template = close::RootChoice::Template(guide);
-    let close::Closed {
+    // The template root, then the cone; a steep, folded margin that its trimming leaves crossing
+    // the root gets both again on its whole margin, untrimmed. The cone's error is reported.
+    let attempts = [
+        (template, close::MAX_TRIMS),
+        (close::RootChoice::Cone, close::MAX_TRIMS),
+        (template, 0),
+        (close::RootChoice::Cone, 0),
+    ];
+    let (mut first, mut reported): (Option<String>, Option<ImportError>) = (None, None);
+    let mut closed = None;
+    // Untrimmed, the crossings are cut out instead: at most a quarter of the crown, so a crown
+    // that would lose more is rebuilt from its whole scanned surface.
+    let untrimmed = RepairLimits {
+        max_cut_fraction: limits.max_cut_fraction.min(UNTRIMMED_CUT_FRACTION),
+        ..*limits
+    };
+    for (k, (choice, trims)) in attempts.into_iter().enumerate() {
+        let mut tried = cleaned.clone();
+        let l = if trims == 0 { &untrimmed } else { limits };
+        match close::close(
+            crown.clone(),
+            fdi,
+            an.root_length,
+            l,
+            &mut tried,
+            choice,
+            trims,
+        ) {
+            Ok(c) => {
+                if k > 0
+                    && let Some(r) = &mut tried.root
+                    && r.kind == "cone"
+                    && let Some(e) = &first
+                {
+                    r.fallback = Some(format!("the template root could not be closed: {e}"));
+                }
+                repairs = tried;
+                closed = Some(c);
+                break;
+            }
+            Err(e) => {
+                // Only a mesh that crosses itself gets the later attempts.
+                let crossing = matches!(e, ImportError::SelfIntersecting { .. });
+                first.get_or_insert_with(|| e.to_string());
+                if k <= 1 {
+                    reported = Some(e);
+                }
+                if !crossing && k >= 1 {
+                    break;
+                }
+            }
+        }
+    }
+    let Some(close::Closed {
         mesh,
         cervical,
         apical,
         crown_rotation,
-    } = match close::close(
-        crown.clone(),
-        fdi,
-        an.root_length,
-        limits,
-        &mut repairs,
-        template,
-    ) {
-        Ok(c) => c,
-        Err(e) => {
-            repairs = cleaned;
-            let c = close::close(
-                crown,
-                fdi,
-                an.root_length,
-                limits,
-                &mut repairs,
-                close::RootChoice::Cone,
-            )?;
-            if let Some(r) = &mut repairs.root {
-                r.fallback = Some(format!("the template root could not be closed: {e}"));
-            }
-            c
-        }
+    }) = closed
+    else {
+        return Err(reported.expect("the first attempts failed"));
     };
     Ok(Prepared {
         mesh,
