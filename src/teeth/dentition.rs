@@ -44,7 +44,12 @@ pub struct PlacedTooth {
 impl PlacedTooth {
     /// Unit mesial, buccal and occlusal directions in the world frame.
     pub fn anatomical_axes(&self) -> [Vec3; 3] {
-        let r = self.pose.rotation;
+        self.anatomical_axes_at(&self.pose)
+    }
+
+    /// [`PlacedTooth::anatomical_axes`] with the tooth at `pose` instead of where it stands.
+    pub fn anatomical_axes_at(&self, pose: &Pose) -> [Vec3; 3] {
+        let r = pose.rotation;
         [
             r * (Vec3::X * self.fdi.local_x_mesial_sign()),
             r * Vec3::Z,

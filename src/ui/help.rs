@@ -109,6 +109,6 @@ pub(super) fn help_window(
             ui.separator();
             ui.label("The guide: docs/ in the repository (docs/getting-started.md first).");
         });
-    open.0 = shown && open.0;
+    open.0 &= shown;
     Ok(())
 }

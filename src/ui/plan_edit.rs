@@ -119,13 +119,8 @@ impl Default for TargetEditor {
 
 /// The tooth's mesial, buccal and occlusal axes at `pose` (world) and its crown centre there.
 fn frame(t: &PlacedTooth, pose: &Pose) -> ([Vec3; 3], Vec3) {
-    let r = pose.rotation;
     (
-        [
-            r * (Vec3::X * t.fdi.local_x_mesial_sign()),
-            r * Vec3::Z,
-            r * Vec3::Y,
-        ],
+        t.anatomical_axes_at(pose),
         pose.transform_point(t.geometry.frame.crown_centre),
     )
 }

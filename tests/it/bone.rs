@@ -118,16 +118,7 @@ fn simulate_reports_a_root_at_a_plate_in_its_table_and_json() {
         if json {
             args.push("--json");
         }
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
-            .args(&args)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8(out.stdout).unwrap()
+        String::from_utf8(crate::cli::succeed(&args).stdout).unwrap()
     };
     let table = run(false);
     assert!(

@@ -2,7 +2,7 @@
 
 use std::process::Command;
 
-fn orthosim(args: &[&str]) -> std::process::Output {
+pub(crate) fn orthosim(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_orthosim"))
         .args(args)
         .output()
@@ -10,7 +10,7 @@ fn orthosim(args: &[&str]) -> std::process::Output {
 }
 
 /// Runs `orthosim` with `args`, which must succeed (else the test fails with its stderr).
-fn succeed(args: &[&str]) -> std::process::Output {
+pub(crate) fn succeed(args: &[&str]) -> std::process::Output {
     let out = orthosim(args);
     assert!(
         out.status.success(),

@@ -292,17 +292,14 @@ fn bad_limits_files_are_refused_with_their_position() {
 fn the_plan_command_writes_its_files_and_json() {
     let dir = std::env::temp_dir().join(format!("orthosim-plan-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
-        .args(["plan", "--case", "crowded", "--out"])
-        .arg(&dir)
-        .arg("--json")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = crate::cli::succeed(&[
+        "plan",
+        "--case",
+        "crowded",
+        "--out",
+        dir.to_str().unwrap(),
+        "--json",
+    ]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for key in [
         "case",
@@ -358,13 +355,16 @@ fn the_plan_command_writes_its_files_and_json() {
     let target = dir.join("t.ron");
     let plan_to = |text: &str, out: &str| {
         std::fs::write(&target, text).unwrap();
-        std::process::Command::new(env!("CARGO_BIN_EXE_orthosim"))
-            .args(["plan", "--case", "case1", "--target"])
-            .arg(&target)
-            .arg("--out")
-            .arg(dir.join(out))
-            .output()
-            .unwrap()
+        let out = dir.join(out);
+        crate::cli::orthosim(&[
+            "plan",
+            "--case",
+            "case1",
+            "--target",
+            target.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
     };
     let out = plan_to("{\n  18: (translation: (0.1, 0.0, 0.0)),\n}", "again");
     assert!(out.status.success(), "18 is present in case 1");

@@ -384,7 +384,8 @@ pub fn prepare_guided(
         (template, 0),
         (close::RootChoice::Cone, 0),
     ];
-    let (mut first, mut reported): (Option<String>, Option<ImportError>) = (None, None);
+    // The template's own error (for the cone's report), and the cone's (for the caller).
+    let (mut template_error, mut reported): (Option<String>, Option<ImportError>) = (None, None);
     let mut closed = None;
     // Untrimmed, the crossings are cut out instead: at most a quarter of the crown, so a crown
     // that would lose more is rebuilt from its whole scanned surface.
@@ -408,7 +409,7 @@ pub fn prepare_guided(
                 if k > 0
                     && let Some(r) = &mut tried.root
                     && r.kind == "cone"
-                    && let Some(e) = &first
+                    && let Some(e) = &template_error
                 {
                     r.fallback = Some(format!("the template root could not be closed: {e}"));
                 }
@@ -419,7 +420,9 @@ pub fn prepare_guided(
             Err(e) => {
                 // Only a mesh that crosses itself gets the later attempts.
                 let crossing = matches!(e, ImportError::SelfIntersecting { .. });
-                first.get_or_insert_with(|| e.to_string());
+                if k == 0 {
+                    template_error = Some(e.to_string());
+                }
                 if k <= 1 {
                     reported = Some(e);
                 }
