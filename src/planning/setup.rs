@@ -161,7 +161,8 @@ impl<'a> ArchSetter<'a> {
         if (y - t.pose.translation.y).abs() <= KEEP_LEVEL_MM {
             y = t.pose.translation.y;
         }
-        Pose::new(rotation, Vec3::new(p.x, y, p.y))
+        let prominence = self.layout.buccal_offset[self.row()][t.fdi.position() as usize - 1];
+        Pose::new(rotation, Vec3::new(p.x, y, p.y) + out * prominence)
     }
 
     /// Signed gap between teeth `i` and `j` at the given poses.

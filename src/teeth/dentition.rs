@@ -328,14 +328,28 @@ impl Dentition {
     }
 }
 
-/// The arch forms fitted to the cervical centres (local origins) of each arch's present teeth,
+/// The arch forms fitted to the cervical centres (local origins) of each arch's present teeth
+/// (less the arrangement's buccal offsets),
 /// starting from `start` (upper, lower).
 fn fitted_forms(teeth: &[PlacedTooth], start: [BetaArch; 2]) -> [BetaArch; 2] {
+    // A tooth the arrangement sets out from its curve (the upper canines' prominence) counts
+    // where its curve runs: its centre less that offset along the curve's outward normal.
+    let layout = ArchLayout::default();
     let fit = |arch: Arch, form: BetaArch| {
+        let curve = ArchCurve::new(&form);
+        let row = usize::from(arch == Arch::Lower);
         let points: Vec<glam::Vec2> = teeth
             .iter()
             .filter(|t| t.fdi.arch() == arch && !t.extracted)
-            .map(|t| glam::Vec2::new(t.pose.translation.x, t.pose.translation.z))
+            .map(|t| {
+                let p = glam::Vec2::new(t.pose.translation.x, t.pose.translation.z);
+                let offset = layout.buccal_offset[row][t.fdi.position() as usize - 1];
+                if offset == 0.0 || !p.is_finite() {
+                    return p;
+                }
+                let (_, tangent) = curve.at(curve.project(p));
+                p - glam::Vec2::new(-tangent.y, tangent.x) * offset
+            })
             .collect();
         form.fit(&points)
     };

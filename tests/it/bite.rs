@@ -236,3 +236,77 @@ fn a_settled_bite_placed_in_a_simulation_stays_there() {
         assert_eq!(sim.teeth[*i].pose, *p);
     }
 }
+
+#[test]
+fn the_canine_guided_layout_lets_the_working_canine_guide_laterals() {
+    use orthosim::analysis::{ExcursionKind, excursion};
+    use orthosim::teeth::{
+        ShapeSet, ToothKind, ToothResolution,
+        arch::{ArchLayout, Spaces, arrange},
+    };
+    // The normal arrangement's canines do not guide (the lateral incisors do); the canine-guided
+    // layout's do, on both sides, with the posterior teeth of the working side apart.
+    let shapes = ShapeSet::shared(ToothResolution::PAPER);
+    let guidance = |layout: &ArchLayout| {
+        let a = arrange(&shapes, layout, &Spaces::new());
+        let geometries: Vec<_> = a
+            .poses
+            .iter()
+            .map(|(f, _)| shapes.get(f.arch(), f.kind()))
+            .collect();
+        let teeth: Vec<Posed> = a
+            .poses
+            .iter()
+            .zip(&geometries)
+            .map(|((fdi, pose), geometry)| Posed {
+                fdi: *fdi,
+                geometry,
+                pose: *pose,
+            })
+            .collect();
+        let b = bite("canine-guided", &teeth, true, 0.0);
+        let runs = [
+            ExcursionKind::Right,
+            ExcursionKind::Left,
+            ExcursionKind::Protrusive,
+        ]
+        .map(|kind| excursion(&teeth, &b.lower_pose, kind, 3.0));
+        (b, runs)
+    };
+    let (_, normal) = guidance(&ArchLayout::default());
+    assert!(
+        normal[0].steps.iter().all(|s| s.guidance != "canine"),
+        "{:?}",
+        normal[0]
+    );
+    let (b, [right, left, protrusive]) = guidance(&ArchLayout::canine_guided());
+    assert!(b.stable, "{b:?}");
+    assert!(b.max_penetration_mm <= 0.01, "{b:?}");
+    assert!((0.05..=0.3).contains(&b.incisor_gap_mm), "{b:?}");
+    assert!(
+        b.contact_teeth.left >= 4 && b.contact_teeth.right >= 4,
+        "{b:?}"
+    );
+    for (run, working) in [(&right, 1), (&left, 2)] {
+        for s in &run.steps {
+            // The working canines meet, and nothing posterior meets on the working side.
+            assert_eq!(s.guidance, "canine", "{s:?}");
+            assert!(
+                s.contacts.iter().any(|[u, l]| u.quadrant() == working
+                    && u.kind() == ToothKind::Canine
+                    && l.kind() == ToothKind::Canine),
+                "{s:?}"
+            );
+            assert!(s.interferences.is_empty(), "{s:?}");
+        }
+    }
+    // Protrusion: the front teeth alone from 1 mm on.
+    for s in protrusive.steps.iter().filter(|s| s.mm > 1.0 + 1e-3) {
+        assert!(
+            s.contacts
+                .iter()
+                .all(|[u, l]| !u.kind().is_posterior() && !l.kind().is_posterior()),
+            "{s:?}"
+        );
+    }
+}

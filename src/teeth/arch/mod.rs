@@ -11,7 +11,8 @@
 //! Arrangement (all numbers are parameters in [`ArchLayout`]):
 //! 1. Each arch: the central incisors are placed symmetrically about the midline, then every tooth
 //!    distally slides along the curve until the exact triangle-level gap to its mesial neighbour is
-//!    `contact_gap` (bisection on the arc position; the gap grows monotonically with it).
+//!    `contact_gap` (bisection on the arc position; the gap grows monotonically with it); a tooth
+//!    with a `buccal_offset` stands that far out of the curve.
 //! 2. The upper curve's width and depth are solved so that the upper first molars stand
 //!    `buccal_overlap` buccal to the lower ones and their mesiobuccal cusps sit over the lower first
 //!    molars' buccal grooves (Angle class I): nested bisections on a fast model (teeth at their
@@ -21,8 +22,8 @@
 //!    teeth is `occlusal_gap` (bisection on its height).
 //! 4. The bite is levelled as a settled class I bite is: each lower premolar and molar is raised or
 //!    lowered until its exact gap to the upper arch is `occlusal_gap`, each lower incisor until its
-//!    gap is `incisor_gap` (the incisors just out of contact), and a lower canine closer than that
-//!    is lowered to it; then each upper premolar and molar still farther than `occlusal_gap` from
+//!    gap is its `anterior_gap` (the incisors just out of contact), and a lower canine closer than
+//!    its gap is lowered to it (or, with `raise_canines`, levelled to it both ways); then each upper premolar and molar still farther than `occlusal_gap` from
 //!    the lower arch comes down to it, so every posterior tooth of both arches meets its
 //!    antagonists. Both arches are then placed along their curves again at the new heights, so
 //!    adjacent crowns keep their `contact_gap`, and the levelling is repeated until no tooth moves
@@ -58,9 +59,12 @@ pub struct ArchLayout {
     pub contact_gap: f32,
     /// Exact gap (mm) between each lower premolar and molar and the upper arch.
     pub occlusal_gap: f32,
-    /// Exact gap (mm) between each lower incisor and the upper arch; the lower canines stand at
-    /// least this far from it.
-    pub incisor_gap: f32,
+    /// Exact gap (mm) between each lower central incisor, lateral incisor and canine and the upper
+    /// arch (a lower canine farther than its gap stays where it is unless `raise_canines`).
+    pub anterior_gap: [f32; 3],
+    /// Whether the lower canines are raised to their gap as the incisors are, not only lowered to
+    /// it.
+    pub raise_canines: bool,
     /// How far the upper curve's front lies ahead of the lower's at the cervical level (mm); the
     /// incisors' labial inclination adds the rest of the overjet at the incisal edges.
     pub overjet_offset: f32,
@@ -71,6 +75,10 @@ pub struct ArchLayout {
     /// Height of each tooth's occlusal tip above (lower) or below (upper) the occlusal plane (mm),
     /// upper then lower, by position; sets the overbite of the anterior teeth.
     pub tip_level: [[f32; 8]; 2],
+    /// How far buccal (labial) of its curve each tooth stands (mm), upper then lower, by
+    /// position: the upper canines' prominence, which puts their lingual surfaces over the lower
+    /// canines' labial surfaces.
+    pub buccal_offset: [[f32; 8]; 2],
 }
 
 impl Default for ArchLayout {
@@ -83,7 +91,8 @@ impl Default for ArchLayout {
             },
             contact_gap: 0.05,
             occlusal_gap: 0.01,
-            incisor_gap: 0.12,
+            anterior_gap: [0.12, 0.12, 0.12],
+            raise_canines: false,
             overjet_offset: 0.0,
             buccal_overlap: 2.2,
             inclination_deg: [
@@ -94,7 +103,25 @@ impl Default for ArchLayout {
                 [1.2, 1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0],
                 [1.2, 1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0],
             ],
+            buccal_offset: [[0.0; 8]; 2],
         }
+    }
+}
+
+impl ArchLayout {
+    /// The layout whose canines guide the jaw's lateral excursions (canine-protected
+    /// occlusion): the upper canines stand 1.8 mm labial of their curve (the canine eminence)
+    /// with their tips 0.9 mm below the occlusal plane, and the lower canines are raised until
+    /// their labial surfaces are 0.05 mm under the upper canines' lingual surfaces; the lower
+    /// lateral incisors stand 0.2 mm from the upper arch, so the canines meet first. Not yet the
+    /// built-in cases' layout (see the guide's occlusion chapter).
+    pub fn canine_guided() -> Self {
+        let mut layout = Self::default();
+        layout.tip_level[0][2] = 0.9;
+        layout.buccal_offset[0][2] = 1.8;
+        layout.anterior_gap = [0.12, 0.2, 0.05];
+        layout.raise_canines = true;
+        layout
     }
 }
 
@@ -173,7 +200,8 @@ fn pose_on_curve(
     let x = up.cross(out);
     let base = Quat::from_mat3(&Mat3::from_cols(x, up, out));
     let incline = Quat::from_axis_angle(x, layout.inclination_deg[row][k].to_radians());
-    Pose::new((incline * base).normalize(), Vec3::new(p.x, y, p.y))
+    let at = Vec3::new(p.x, y, p.y) + out * layout.buccal_offset[row][k];
+    Pose::new((incline * base).normalize(), at)
 }
 
 /// Signed gap between two posed shapes (negative when they overlap).
@@ -489,8 +517,12 @@ pub fn arrange(shapes: &ShapeSet, layout: &ArchLayout, spaces: &Spaces) -> Arran
             };
             let target = match fl.kind() {
                 _ if posterior(*fl) => layout.occlusal_gap,
-                ToothKind::Canine if least(0.0) >= layout.incisor_gap => continue,
-                _ => layout.incisor_gap,
+                ToothKind::Canine
+                    if !layout.raise_canines && least(0.0) >= layout.anterior_gap[2] =>
+                {
+                    continue;
+                }
+                _ => layout.anterior_gap[fl.position() as usize - 1],
             };
             let drop = drop_to(least, target);
             *raise.entry(*fl).or_insert(0.0) -= drop;
