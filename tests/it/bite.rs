@@ -244,8 +244,8 @@ fn the_canine_guided_layout_lets_the_working_canine_guide_laterals() {
         ShapeSet, ToothKind, ToothResolution,
         arch::{ArchLayout, Spaces, arrange},
     };
-    // The normal arrangement's canines do not guide (the lateral incisors do); the canine-guided
-    // layout's do, on both sides, with the posterior teeth of the working side apart.
+    // The canine-guided layout's working canines guide both laterals, with the posterior teeth
+    // of the working side apart.
     let shapes = ShapeSet::shared(ToothResolution::PAPER);
     let guidance = |layout: &ArchLayout| {
         let a = arrange(&shapes, layout, &Spaces::new());
