@@ -328,9 +328,8 @@ impl Dentition {
     }
 }
 
-/// The arch forms fitted to the cervical centres (local origins) of each arch's present teeth
-/// (less the arrangement's buccal offsets),
-/// starting from `start` (upper, lower).
+/// The arch forms fitted to the cervical centres (local origins) of each arch's present teeth,
+/// less the arrangement's buccal offsets, starting from `start` (upper, lower).
 fn fitted_forms(teeth: &[PlacedTooth], start: [BetaArch; 2]) -> [BetaArch; 2] {
     // A tooth the arrangement sets out from its curve (the upper canines' prominence) counts
     // where its curve runs: its centre less that offset along the curve's outward normal.

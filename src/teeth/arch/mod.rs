@@ -23,11 +23,12 @@
 //! 4. The bite is levelled as a settled class I bite is: each lower premolar and molar is raised or
 //!    lowered until its exact gap to the upper arch is `occlusal_gap`, each lower incisor until its
 //!    gap is its `anterior_gap` (the incisors just out of contact), and a lower canine closer than
-//!    its gap is lowered to it (or, with `raise_canines`, levelled to it both ways); then each upper premolar and molar still farther than `occlusal_gap` from
-//!    the lower arch comes down to it, so every posterior tooth of both arches meets its
-//!    antagonists. Both arches are then placed along their curves again at the new heights, so
-//!    adjacent crowns keep their `contact_gap`, and the levelling is repeated until no tooth moves
-//!    by more than 0.001 mm (at most four rounds).
+//!    its gap is lowered to it (or, with `raise_canines`, levelled to it both ways); then each
+//!    upper premolar and molar still farther than `occlusal_gap` from the lower arch comes down
+//!    to it, so every posterior tooth of both arches meets its antagonists. Both arches are then
+//!    placed along their curves again at the new heights, so adjacent crowns keep their
+//!    `contact_gap`, and the levelling is repeated until no tooth moves by more than 0.001 mm (at
+//!    most four rounds).
 
 use std::{collections::BTreeMap, sync::Arc};
 
