@@ -479,56 +479,71 @@ fn limits_ui(ui: &mut egui::Ui, edited: &mut PlanLimits) {
                 ui.end_row();
             }
         });
-    egui::ComboBox::from_label("sequence")
-        .selected_text(edited.sequence.name())
-        .show_ui(ui, |ui| {
-            for s in [
-                Sequence::AllAtOnce,
-                Sequence::AnteriorsFirst,
-                Sequence::VPattern,
-            ] {
-                ui.selectable_value(&mut edited.sequence, s, s.name());
-            }
-        })
-        .response
-        .on_hover_text("which teeth start moving first");
-    egui::ComboBox::from_label("arch form")
-        .selected_text(edited.arch_form.name())
-        .show_ui(ui, |ui| {
-            for f in [
-                TargetForm::Fitted,
-                TargetForm::Ovoid,
-                TargetForm::Tapered,
-                TargetForm::Square,
-            ] {
-                ui.selectable_value(&mut edited.arch_form, f, f.name());
-            }
-        })
-        .response
-        .on_hover_text("the form the target aligns the teeth on: fitted to them, or a preformed one sized to it");
+    choice(
+        ui,
+        "sequence",
+        &mut edited.sequence,
+        &[
+            Sequence::AllAtOnce,
+            Sequence::AnteriorsFirst,
+            Sequence::VPattern,
+        ],
+        Sequence::name,
+        "which teeth start moving first",
+    );
+    choice(
+        ui,
+        "arch form",
+        &mut edited.arch_form,
+        &[
+            TargetForm::Fitted,
+            TargetForm::Ovoid,
+            TargetForm::Tapered,
+            TargetForm::Square,
+        ],
+        TargetForm::name,
+        "the form the target aligns the teeth on: fitted to them, or a preformed one sized to it",
+    );
     ui.horizontal(|ui| {
         for (label, value) in [
             ("upper", &mut edited.anchorage.upper),
             ("lower", &mut edited.anchorage.lower),
         ] {
-            egui::ComboBox::from_label(format!("{label} anchorage"))
-                .selected_text(value.name())
-                .show_ui(ui, |ui| {
-                    for a in [
-                        Anchorage::Auto,
-                        Anchorage::Minimum,
-                        Anchorage::Moderate,
-                        Anchorage::Maximum,
-                    ] {
-                        ui.selectable_value(value, a, a.name());
-                    }
-                })
-                .response
-                .on_hover_text(
-                    "which teeth close the arch's spaces: minimum, the posterior teeth come forward; maximum, the anterior teeth retract; auto, the share that brings canines and molars nearest class I keeping the overjet",
-                );
+            choice(
+                ui,
+                &format!("{label} anchorage"),
+                value,
+                &[
+                    Anchorage::Auto,
+                    Anchorage::Minimum,
+                    Anchorage::Moderate,
+                    Anchorage::Maximum,
+                ],
+                Anchorage::name,
+                "which teeth close the arch's spaces: minimum, the posterior teeth come forward; maximum, the anterior teeth retract; auto, the share that brings canines and molars nearest class I keeping the overjet",
+            );
         }
     });
+}
+
+/// A combo box choosing `value` among `options`, each shown by `name`, with a tooltip.
+fn choice<T: Copy + PartialEq>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut T,
+    options: &[T],
+    name: fn(T) -> &'static str,
+    tip: &str,
+) {
+    egui::ComboBox::from_label(label)
+        .selected_text(name(*value))
+        .show_ui(ui, |ui| {
+            for &o in options {
+                ui.selectable_value(value, o, name(o));
+            }
+        })
+        .response
+        .on_hover_text(tip);
 }
 
 /// Step buttons for the edited tooth's six movements; the one pressed.
